@@ -1,0 +1,359 @@
+/* libwetcloth: wet cloth as a mass-spring system.
+ *
+ * The one public header. Everything here is plain C99 with fixed-width types:
+ * opaque handles, description structs that come with a `..._default()` function,
+ * status codes with a message that names what was wrong.
+ *
+ * Units are SI throughout: metres, kilograms, seconds, newtons.
+ *
+ * Ownership: the world owns everything added to it. Cloths and colliders are
+ * addressed by the small integer index their `add` call returned; indices stay
+ * valid for the world's lifetime.
+ *
+ * Threading: one world must not be used from two threads at once. Different
+ * worlds are independent. Inside a step the world uses OpenMP threads
+ * (see wc_world_def.thread_count); results are bitwise identical for any
+ * thread count.
+ */
+#ifndef WETCLOTH_H
+#define WETCLOTH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32) && defined(WC_BUILD_SHARED)
+#define WC_API __declspec(dllexport)
+#elif defined(__GNUC__)
+#define WC_API __attribute__((visibility("default")))
+#else
+#define WC_API
+#endif
+
+/// Version of this header. wc_version() gives the library's at run time.
+#define WC_VERSION_MAJOR 0
+#define WC_VERSION_MINOR 1
+#define WC_VERSION_PATCH 0
+/// Single number: major * 10000 + minor * 100 + patch.
+#define WC_VERSION (WC_VERSION_MAJOR * 10000 + WC_VERSION_MINOR * 100 + WC_VERSION_PATCH)
+
+/// Library version as major * 10000 + minor * 100 + patch.
+WC_API int32_t wc_version(void);
+/// Library version as "major.minor.patch".
+WC_API const char *wc_version_string(void);
+
+/// Result of every call that can fail. On anything but WC_OK the call changed
+/// nothing, and wc_world_last_error() (or the wc_message of wc_world_create)
+/// says what was wrong.
+typedef enum wc_status {
+    WC_OK = 0,
+    /// An argument is out of range, not finite, inconsistent or NULL.
+    WC_ERROR_INVALID_ARGUMENT = 1,
+    /// An allocation failed; the world is as it was before the call.
+    WC_ERROR_OUT_OF_MEMORY = 2,
+    /// The step would have produced a non-finite position (usually a time step
+    /// far above wc_world_stable_dt()). The world keeps its last good state.
+    WC_ERROR_NON_FINITE = 3,
+    /// A cloth or collider index that the world does not have.
+    WC_ERROR_NOT_FOUND = 4
+} wc_status;
+
+/// Short name of a status, e.g. "WC_ERROR_INVALID_ARGUMENT".
+WC_API const char *wc_status_name(wc_status status);
+
+/// Error text for calls that have no world to keep it in (wc_world_create).
+typedef struct wc_message {
+    char text[256];
+} wc_message;
+
+/* ------------------------------------------------------------------------ */
+/* World                                                                    */
+/* ------------------------------------------------------------------------ */
+
+typedef struct wc_world wc_world;
+
+/// How a step advances positions.
+typedef enum wc_integrator {
+    /// Position Verlet, x(t+dt) = 2x(t) - x(t-dt) + a dt^2 (thesis eq. 2.4).
+    /// Explicit: stable for dt below wc_world_stable_dt().
+    WC_INTEGRATOR_VERLET = 0
+} wc_integrator;
+
+/// Description of a world. Start from wc_world_def_default().
+typedef struct wc_world_def {
+    /// Gravitational acceleration, m/s^2, finite. Default (0, 0, -9.81).
+    double gravity[3];
+    /// OpenMP threads used inside a step. 0 = OpenMP's default; 1 .. 1024.
+    /// Ignored when the library was built without OpenMP.
+    int32_t thread_count;
+    /// Integrator. Default WC_INTEGRATOR_VERLET.
+    wc_integrator integrator;
+    /// Fraction of the stable step that automatic substepping uses,
+    /// (0, 1]. Default 0.9.
+    double substep_safety;
+    /// Largest number of substeps wc_world_advance() may choose on its own,
+    /// 1 .. 10^7. Default 100000. Asking for more is an error, not a silent cap.
+    int32_t max_substeps;
+} wc_world_def;
+
+/// The default world description.
+WC_API wc_world_def wc_world_def_default(void);
+
+/// Creates a world. On failure *out_world is NULL and, when out_message is not
+/// NULL, its text says what was wrong.
+WC_API wc_status wc_world_create(const wc_world_def *def, wc_world **out_world,
+                                 wc_message *out_message);
+
+/// Destroys a world and everything in it. NULL is allowed.
+WC_API void wc_world_destroy(wc_world *world);
+
+/// Message of the last failed call on this world ("" if none failed yet).
+/// Valid until the next call on the world.
+WC_API const char *wc_world_last_error(const wc_world *world);
+
+/// Advances every cloth by one step of dt seconds, (0, 10] and finite:
+/// forces, integration, collisions, wet response. Pin targets set with
+/// wc_cloth_set_pin_targets() are reached at the end of this step.
+/// On WC_ERROR_NON_FINITE the world keeps the state before the step.
+WC_API wc_status wc_world_step(wc_world *world, double dt);
+
+/// Advances by one frame of frame_dt seconds in `substeps` equal steps.
+/// substeps = 0 picks the smallest count whose step is at most
+/// substep_safety * wc_world_stable_dt() (an error if that exceeds max_substeps).
+/// Pinned particles move linearly from where they were to their targets
+/// across the substeps. If a substep fails, the world keeps the state after
+/// the last good substep (see wc_world_time()).
+WC_API wc_status wc_world_advance(wc_world *world, double frame_dt, int32_t substeps);
+
+/// Largest step, s, at which the integrator is estimated to stay stable for
+/// every cloth in the world (an upper bound on the highest link frequency,
+/// from Gershgorin's theorem, so it errs on the safe side). +inf when there
+/// is no cloth.
+WC_API double wc_world_stable_dt(const wc_world *world);
+
+/// Substeps the last wc_world_advance() used (0 before any).
+WC_API int32_t wc_world_last_substeps(const wc_world *world);
+
+/// Simulated time, s: the sum of all successful steps.
+WC_API double wc_world_time(const wc_world *world);
+
+/// Number of cloths in the world.
+WC_API int32_t wc_world_cloth_count(const wc_world *world);
+
+/* ------------------------------------------------------------------------ */
+/* Material                                                                  */
+/* ------------------------------------------------------------------------ */
+
+/// Cloth material in physical units that do not depend on the mesh
+/// resolution. The library derives per-particle masses and per-link
+/// constants from it:
+///
+/// * particle mass m_i = density * A_i, where A_i is one third of the area
+///   of each triangle and one quarter of each quad around particle i;
+/// * stretch link stiffness K = c * stretch_stiffness * A_e / l^2, where l is
+///   the rest length, A_e the link's share of the area of its faces (each
+///   face shares its area equally among its links: 3 edges of a triangle;
+///   4 edges and 2 diagonals of a quad), and c = 8/3 for triangles,
+///   12/5 for quads: with these the uniaxial-strain modulus of a regular grid
+///   or equilateral triangle mesh equals stretch_stiffness;
+/// * stretch link damping coefficient 2 * stretch_damping * sqrt(K * m_r)
+///   with m_r = m_a m_b / (m_a + m_b) the link's reduced mass;
+/// * bend link constant R = bend_stiffness * A_b / l with l the link's rest
+///   length and A_b = A_a / n_a + A_c / n_c its share of the area of its two
+///   end particles (n = a particle's number of bend links). For a sheet bent
+///   to curvature k, a bend link of rest length l stores 0.5 * R * k^2 * l.
+typedef struct wc_material {
+    /// Areal density of the dry cloth, kg/m^2, (0, 1000]. Default 0.15
+    /// (cotton shirting, 150 g/m^2).
+    double density;
+    /// In-plane stretch stiffness, N/m, [0, 1e9]. Links resist only tension.
+    /// Default 1000.
+    double stretch_stiffness;
+    /// Bending stiffness, N*m, [0, 1e3]. Bend links resist only compression
+    /// (Choi & Ko's buckling model). Default 1e-5.
+    double bend_stiffness;
+    /// Damping along stretch links as a fraction of each link's critical
+    /// damping, [0, 1]. Default 0.05.
+    double stretch_damping;
+    /// Linear air drag, N*s/m^3: force -air_drag * A_i * v on each particle.
+    /// [0, 1e4]. Default 0.02.
+    double air_drag;
+} wc_material;
+
+/// The default material (plausible cotton).
+WC_API wc_material wc_material_default(void);
+
+/* ------------------------------------------------------------------------ */
+/* Cloth                                                                     */
+/* ------------------------------------------------------------------------ */
+
+/// A cloth from a triangle and/or quad mesh.
+typedef struct wc_mesh_cloth_def {
+    /// Rest positions, m, interleaved xyz, 3 * vertex_count finite values.
+    /// Also the starting positions. Copied; the caller keeps ownership.
+    const double *vertices;
+    /// Number of vertices, 3 .. 2^26.
+    int32_t vertex_count;
+    /// Vertex indices of the faces, face_size per face, each in
+    /// [0, vertex_count). With face_size 4, a last index of -1 makes the face
+    /// a triangle, so triangles and quads can mix. Copied.
+    const int32_t *faces;
+    /// Number of faces, 1 .. 2^27.
+    int32_t face_count;
+    /// Indices per face: 3 or 4.
+    int32_t face_size;
+    /// Material.
+    wc_material material;
+} wc_mesh_cloth_def;
+
+/// Default mesh cloth description (no geometry, default material).
+WC_API wc_mesh_cloth_def wc_mesh_cloth_def_default(void);
+
+/// A regular grid of count_u x count_v particles (the thesis' cloth). Particle
+/// (i, j) has index j * count_u + i and rest position
+/// center + (i / (count_u-1) - 0.5) size_u axis_u + (j / (count_v-1) - 0.5) size_v axis_v.
+/// Faces are the grid's quads.
+typedef struct wc_grid_cloth_def {
+    /// Particles along axis_u, 2 .. 32768.
+    int32_t count_u;
+    /// Particles along axis_v, 2 .. 32768. count_u * count_v <= 2^26.
+    int32_t count_v;
+    /// Size along axis_u, m, (0, 1e6]. Default 1.
+    double size_u;
+    /// Size along axis_v, m, (0, 1e6]. Default 1.
+    double size_v;
+    /// Centre of the cloth, m. Default (0, 0, 0).
+    double center[3];
+    /// Direction of u, unit length (within 1e-6). Default (1, 0, 0).
+    double axis_u[3];
+    /// Direction of v, unit length and perpendicular to axis_u (within 1e-6).
+    /// Default (0, 1, 0).
+    double axis_v[3];
+    /// Material.
+    wc_material material;
+} wc_grid_cloth_def;
+
+/// Default grid: 32 x 32 particles, 1 m x 1 m in the plane z = 0.
+WC_API wc_grid_cloth_def wc_grid_cloth_def_default(void);
+
+/// Adds a cloth; *out_cloth receives its index.
+WC_API wc_status wc_world_add_mesh_cloth(wc_world *world, const wc_mesh_cloth_def *def,
+                                         int32_t *out_cloth);
+/// Adds a grid cloth; *out_cloth receives its index.
+WC_API wc_status wc_world_add_grid_cloth(wc_world *world, const wc_grid_cloth_def *def,
+                                         int32_t *out_cloth);
+
+/// Number of particles of a cloth (0 if the index is not a cloth).
+WC_API int32_t wc_cloth_particle_count(const wc_world *world, int32_t cloth);
+
+/// Kinds of links.
+typedef enum wc_link_kind {
+    /// Tension-only links: mesh edges and both diagonals of every quad.
+    WC_LINK_STRETCH = 0,
+    /// Compression-only (buckling) links: (a, c) when (a, b) and (b, c) are
+    /// stretch links and the rest angle a-b-c is at least 150 degrees.
+    WC_LINK_BEND = 1
+} wc_link_kind;
+
+/// Number of links of a kind.
+WC_API int32_t wc_cloth_link_count(const wc_world *world, int32_t cloth, wc_link_kind kind);
+
+/// Copies the links of a kind as particle index pairs (2 * count values,
+/// lower index first, sorted) and their rest lengths (count values, m).
+/// Either output may be NULL. capacity is the number of links the outputs
+/// hold; it must be at least wc_cloth_link_count().
+WC_API wc_status wc_cloth_get_links(const wc_world *world, int32_t cloth, wc_link_kind kind,
+                                    int32_t *out_pairs, double *out_rest_lengths,
+                                    int32_t capacity);
+
+/// Number of triangles of the cloth's surface (quads count as two).
+WC_API int32_t wc_cloth_triangle_count(const wc_world *world, int32_t cloth);
+
+/// Copies the surface triangles, 3 * count particle indices.
+WC_API wc_status wc_cloth_get_triangles(const wc_world *world, int32_t cloth,
+                                        int32_t *out_indices, int32_t capacity);
+
+/// Copies positions, m, interleaved xyz. count must equal the particle count.
+WC_API wc_status wc_cloth_get_positions(const wc_world *world, int32_t cloth,
+                                        double *out_xyz, int32_t count);
+/// Same as wc_cloth_get_positions, as float (what Blender's foreach_set takes).
+WC_API wc_status wc_cloth_get_positions_f32(const wc_world *world, int32_t cloth,
+                                            float *out_xyz, int32_t count);
+
+/// Moves every particle to new positions (m, interleaved xyz, finite) with
+/// zero velocity. Pinned particles move too and stay pinned there.
+WC_API wc_status wc_cloth_set_positions(wc_world *world, int32_t cloth,
+                                        const double *xyz, int32_t count);
+
+/// Velocities, m/s, interleaved xyz: estimated from the last step as
+/// (x - x_prev) / dt, or the velocity set with wc_cloth_set_velocities
+/// before the first step.
+WC_API wc_status wc_cloth_get_velocities(const wc_world *world, int32_t cloth,
+                                         double *out_xyz, int32_t count);
+
+/// Sets velocities, m/s, interleaved xyz, finite. The next step starts from
+/// them exactly (x(dt) = x + v dt + a dt^2 / 2).
+WC_API wc_status wc_cloth_set_velocities(wc_world *world, int32_t cloth,
+                                         const double *xyz, int32_t count);
+
+/// Read-only structure-of-arrays view of one cloth's particles. The pointers
+/// stay valid until the next call that changes the world (a step, advance,
+/// set_positions, ...).
+typedef struct wc_cloth_view {
+    int32_t particle_count;
+    /// Positions, m.
+    const double *x;
+    const double *y;
+    const double *z;
+    /// Masses, kg.
+    const double *mass;
+} wc_cloth_view;
+
+/// Fills a view of a cloth's particles.
+WC_API wc_status wc_cloth_get_view(const wc_world *world, int32_t cloth, wc_cloth_view *out_view);
+
+/// Pins particles where they are now. Indices must be in range and not
+/// already pinned (nor repeated in the list). Pinned particles follow their
+/// targets and feel no forces.
+WC_API wc_status wc_cloth_pin(wc_world *world, int32_t cloth, const int32_t *indices,
+                              int32_t count);
+
+/// Releases every pin.
+WC_API wc_status wc_cloth_unpin_all(wc_world *world, int32_t cloth);
+
+/// Number of pinned particles.
+WC_API int32_t wc_cloth_pin_count(const wc_world *world, int32_t cloth);
+
+/// Sets where the pinned particles go: one xyz target (m, finite) per pin,
+/// in the order the pins were added. They are reached at the end of the next
+/// wc_world_step() or wc_world_advance(), moving linearly across its substeps.
+WC_API wc_status wc_cloth_set_pin_targets(wc_world *world, int32_t cloth,
+                                          const double *targets_xyz, int32_t count);
+
+/// Largest stable step, s, for one cloth (see wc_world_stable_dt).
+WC_API double wc_cloth_stable_dt(const wc_world *world, int32_t cloth);
+
+/// Mechanical energy of a cloth, J.
+typedef struct wc_energy {
+    /// 0.5 m v^2 with v as wc_cloth_get_velocities gives it.
+    double kinetic;
+    /// -m g . x (zero at the origin).
+    double gravity;
+    /// 0.5 K (d - l)^2 over stretched links.
+    double stretch;
+    /// 0.5 R c^2 l over compressed bend links (c the arc curvature), the
+    /// potential whose gradient is the buckling force.
+    double bend;
+} wc_energy;
+
+/// Computes a cloth's energy in its current state.
+WC_API wc_status wc_cloth_get_energy(const wc_world *world, int32_t cloth, wc_energy *out_energy);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* WETCLOTH_H */

@@ -1,0 +1,14 @@
+/* All heap memory of the library goes through these two calls, so that an
+ * out-of-memory path can be tested in one place. */
+#ifndef WC_ALLOC_H
+#define WC_ALLOC_H
+
+#include <stddef.h>
+
+/// Zeroed array of count elements of size bytes; NULL on failure or overflow.
+void *wc_alloc_array(size_t count, size_t size);
+
+/// Frees what wc_alloc_array returned. NULL is allowed.
+void wc_free(void *memory);
+
+#endif

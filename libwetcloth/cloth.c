@@ -1,0 +1,205 @@
+#include "cloth.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "buckling.h"
+#include "status.h"
+
+void wc_cloth_destroy(wc_cloth *c)
+{
+    if (!c) return;
+    double *arrays[] = {c->x,  c->y,  c->z,  c->px,      c->py,      c->pz,      c->nx,
+                        c->ny, c->nz, c->fx, c->fy,      c->fz,      c->vx,      c->vy,
+                        c->vz, c->mass, c->inv_mass, c->stretch_k, c->stretch_c, c->bend_r,
+                        c->link_fx, c->link_fy, c->link_fz, c->pins.from, c->pins.to};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
+    wc_free(c->link_start);
+    wc_free(c->link_list);
+    wc_free(c->pin_slot);
+    wc_free(c->pins.particle);
+    wc_topology_free(&c->topology);
+    wc_free(c);
+}
+
+static int alloc_doubles(double **p, size_t count)
+{
+    *p = wc_alloc_array(count, sizeof **p);
+    return *p != NULL;
+}
+
+static int alloc_particle_arrays(wc_cloth *c)
+{
+    size_t n = (size_t)c->particle_count;
+    size_t links = (size_t)c->topology.stretch.count + (size_t)c->topology.bend.count;
+    int needs_velocity = c->material.stretch_damping > 0.0 || c->material.air_drag > 0.0;
+    int ok = alloc_doubles(&c->x, n) & alloc_doubles(&c->y, n) & alloc_doubles(&c->z, n) &
+             alloc_doubles(&c->px, n) & alloc_doubles(&c->py, n) & alloc_doubles(&c->pz, n) &
+             alloc_doubles(&c->nx, n) & alloc_doubles(&c->ny, n) & alloc_doubles(&c->nz, n) &
+             alloc_doubles(&c->fx, n) & alloc_doubles(&c->fy, n) & alloc_doubles(&c->fz, n) &
+             alloc_doubles(&c->mass, n) & alloc_doubles(&c->inv_mass, n) &
+             alloc_doubles(&c->stretch_k, (size_t)c->topology.stretch.count) &
+             alloc_doubles(&c->bend_r, (size_t)c->topology.bend.count) &
+             alloc_doubles(&c->link_fx, links) & alloc_doubles(&c->link_fy, links) &
+             alloc_doubles(&c->link_fz, links);
+    if (needs_velocity)
+        ok &= alloc_doubles(&c->vx, n) & alloc_doubles(&c->vy, n) & alloc_doubles(&c->vz, n);
+    if (c->material.stretch_damping > 0.0)
+        ok &= alloc_doubles(&c->stretch_c, (size_t)c->topology.stretch.count);
+    c->link_start = wc_alloc_array(n + 1, sizeof *c->link_start);
+    c->link_list = wc_alloc_array(2 * links, sizeof *c->link_list);
+    c->pin_slot = wc_alloc_array(n, sizeof *c->pin_slot);
+    return ok && c->link_start && c->link_list && c->pin_slot;
+}
+
+/* Per-particle link lists in ascending link order: the order in which a
+ * particle sums its link forces, the same for any thread count. */
+static void build_link_lists(wc_cloth *c)
+{
+    const wc_link_set *sets[2] = {&c->topology.stretch, &c->topology.bend};
+    int32_t n = c->particle_count, *start = c->link_start, *list = c->link_list;
+    memset(start, 0, ((size_t)n + 1) * sizeof *start);
+    for (int s = 0; s < 2; ++s)
+        for (int32_t e = 0; e < sets[s]->count; ++e) {
+            start[sets[s]->a[e] + 1]++;
+            start[sets[s]->b[e] + 1]++;
+        }
+    for (int32_t i = 0; i < n; ++i) start[i + 1] += start[i];
+    /* pin_slot is free scratch here: it is reset to -1 right after. */
+    int32_t *fill = c->pin_slot;
+    memset(fill, 0, (size_t)n * sizeof *fill);
+    int32_t offset = 0;
+    for (int s = 0; s < 2; ++s) {
+        for (int32_t e = 0; e < sets[s]->count; ++e) {
+            int32_t a = sets[s]->a[e], b = sets[s]->b[e];
+            list[start[a] + fill[a]++] = offset + e;
+            list[start[b] + fill[b]++] = ~(offset + e);
+        }
+        offset += sets[s]->count;
+    }
+    for (int32_t i = 0; i < n; ++i) c->pin_slot[i] = -1;
+}
+
+/* Gershgorin bound on the highest angular frequency of the linearised
+ * system: omega^2 <= max_i sum_links k (1/m_i + 1/sqrt(m_i m_j)), with k the
+ * stretch K or the buckling stiffness bound 12 pi^2 R / l^3. Damping and drag
+ * shorten the explicit stable step further: for a damped oscillator with
+ * ratio z the limit becomes 2 (sqrt(1 + z^2) - z) / omega, and drag alone
+ * needs dt < 2 m / c. */
+static double estimate_stable_dt(const wc_cloth *c)
+{
+    int32_t n = c->particle_count;
+    const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
+    double omega2 = 0.0;
+    for (int32_t i = 0; i < n; ++i) {
+        double row = 0.0;
+        for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
+            int32_t e = c->link_list[k] >= 0 ? c->link_list[k] : ~c->link_list[k];
+            double stiffness;
+            int32_t a, b;
+            if (e < st->count) {
+                stiffness = c->stretch_k[e];
+                a = st->a[e], b = st->b[e];
+            } else {
+                int32_t f = e - st->count;
+                double l = bd->rest[f];
+                stiffness = WC_BUCKLING_STIFFNESS_BOUND * c->bend_r[f] / (l * l * l);
+                a = bd->a[f], b = bd->b[f];
+            }
+            int32_t j = a == i ? b : a;
+            row += stiffness * (c->inv_mass[i] + sqrt(c->inv_mass[i] * c->inv_mass[j]));
+        }
+        if (row > omega2) omega2 = row;
+    }
+    double z = c->material.stretch_damping;
+    double dt = omega2 > 0.0 ? 2.0 * (sqrt(1.0 + z * z) - z) / sqrt(omega2) : INFINITY;
+    if (c->material.air_drag > 0.0) {
+        double drag_dt = 2.0 * c->material.density / c->material.air_drag;
+        if (drag_dt < dt) dt = drag_dt;
+    }
+    return dt;
+}
+
+/* Turns area shares into masses and link constants (see wc_material). */
+static wc_status apply_material(wc_cloth *c, wc_message *msg)
+{
+    const wc_topology *t = &c->topology;
+    const wc_material *m = &c->material;
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        c->mass[i] = m->density * t->area[i];
+        c->inv_mass[i] = 1.0 / c->mass[i];
+    }
+    for (int32_t e = 0; e < t->stretch.count; ++e) {
+        double l = t->stretch.rest[e];
+        if (!(l > 0.0))
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                           "cloth vertices %d and %d are linked but lie at the same point",
+                           (int)t->stretch.a[e], (int)t->stretch.b[e]);
+        c->stretch_k[e] = m->stretch_stiffness * t->stretch.share[e] / (l * l);
+        if (c->stretch_c) {
+            double ma = c->mass[t->stretch.a[e]], mb = c->mass[t->stretch.b[e]];
+            c->stretch_c[e] = 2.0 * m->stretch_damping * sqrt(c->stretch_k[e] * ma * mb / (ma + mb));
+        }
+    }
+    for (int32_t e = 0; e < t->bend.count; ++e)
+        c->bend_r[e] = m->bend_stiffness * t->bend.share[e] / t->bend.rest[e];
+    c->stable_dt = estimate_stable_dt(c);
+    return WC_OK;
+}
+
+wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const int32_t *faces,
+                          int32_t face_count, int32_t face_size, const wc_material *material,
+                          wc_message *msg)
+{
+    *out = NULL;
+    wc_cloth *c = wc_alloc_array(1, sizeof *c);
+    if (!c) return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a cloth");
+    c->particle_count = n;
+    c->material = *material;
+    wc_status s = wc_topology_build(&c->topology, xyz, n, faces, face_count, face_size, msg);
+    if (s) {
+        wc_free(c);
+        return s;
+    }
+    if (!alloc_particle_arrays(c)) {
+        wc_cloth_destroy(c);
+        return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a cloth of %d vertices",
+                       (int)n);
+    }
+    for (int32_t i = 0; i < n; ++i) {
+        c->x[i] = xyz[3 * (size_t)i];
+        c->y[i] = xyz[3 * (size_t)i + 1];
+        c->z[i] = xyz[3 * (size_t)i + 2];
+    }
+    build_link_lists(c);
+    s = apply_material(c, msg);
+    if (s) {
+        wc_cloth_destroy(c);
+        return s;
+    }
+    *out = c;
+    return WC_OK;
+}
+
+void wc_cloth_commit(wc_cloth *c, double dt)
+{
+    double *t;
+    t = c->px, c->px = c->x, c->x = c->nx, c->nx = t;
+    t = c->py, c->py = c->y, c->y = c->ny, c->ny = t;
+    t = c->pz, c->pz = c->z, c->z = c->nz, c->nz = t;
+    c->has_history = 1;
+    c->dt_prev = dt;
+}
+
+void wc_cloth_velocity(const wc_cloth *c, int32_t i, double v[3])
+{
+    if (!c->has_history) {
+        v[0] = c->px[i], v[1] = c->py[i], v[2] = c->pz[i];
+        return;
+    }
+    double inv_dt = 1.0 / c->dt_prev;
+    v[0] = (c->x[i] - c->px[i]) * inv_dt;
+    v[1] = (c->y[i] - c->py[i]) * inv_dt;
+    v[2] = (c->z[i] - c->pz[i]) * inv_dt;
+}

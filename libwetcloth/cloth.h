@@ -1,0 +1,81 @@
+/* A cloth: particles in structure-of-arrays form, its topology, the per-link
+ * constants derived from its material, and its pins. */
+#ifndef WC_CLOTH_H
+#define WC_CLOTH_H
+
+#include <stdint.h>
+
+#include "topology.h"
+#include "wetcloth.h"
+
+/// Pinned particles and where they move during the current advance.
+typedef struct wc_pins {
+    int32_t count;
+    /// Particle index of each pin, in the order they were added.
+    int32_t *particle;
+    /// xyz per pin: where the pin was at the start of the advance...
+    double *from;
+    /// ...and where it must be at its end.
+    double *to;
+} wc_pins;
+
+typedef struct wc_cloth {
+    int32_t particle_count;
+    /// Positions now, m.
+    double *x, *y, *z;
+    /// Positions one step ago. Before the first step (has_history == 0) they
+    /// hold the starting velocity instead, m/s, so the first step can be the
+    /// exact x + v dt + a dt^2 / 2.
+    double *px, *py, *pz;
+    /// Positions after the step being computed; committed only when the
+    /// whole step succeeded, so a failed step leaves x and px untouched.
+    double *nx, *ny, *nz;
+    /// Total force on each particle, N.
+    double *fx, *fy, *fz;
+    /// Velocity estimate used by damping and drag, m/s (allocated only when
+    /// the material has either).
+    double *vx, *vy, *vz;
+    double *mass;
+    double *inv_mass;
+    int has_history;
+    /// Length of the last step, s.
+    double dt_prev;
+
+    wc_material material;
+    wc_topology topology;
+    /// Stretch stiffness K per stretch link, N/m.
+    double *stretch_k;
+    /// Damping coefficient per stretch link, N s/m (NULL without damping).
+    double *stretch_c;
+    /// Buckling constant R per bend link, N m^2.
+    double *bend_r;
+    /// Force on the lower-index end of each link, N: stretch links first,
+    /// then bend links. Written once per link, then gathered per particle.
+    double *link_fx, *link_fy, *link_fz;
+    /// Links of each particle (CSR): entry k >= 0 means link k with this
+    /// particle at its first end (force +), ~k at its second end (force -).
+    int32_t *link_start;
+    int32_t *link_list;
+
+    /// Pin slot of each particle, or -1 when free.
+    int32_t *pin_slot;
+    wc_pins pins;
+
+    /// Stable step estimate, s (see wc_world_stable_dt).
+    double stable_dt;
+} wc_cloth;
+
+/// Creates a cloth from a validated description. On failure nothing leaks.
+wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t vertex_count,
+                          const int32_t *faces, int32_t face_count, int32_t face_size,
+                          const wc_material *material, wc_message *msg);
+
+void wc_cloth_destroy(wc_cloth *cloth);
+
+/// Moves px/x/nx one step on after a successful step of length dt.
+void wc_cloth_commit(wc_cloth *cloth, double dt);
+
+/// Velocity of particle i, m/s (see wc_cloth_get_velocities).
+void wc_cloth_velocity(const wc_cloth *cloth, int32_t i, double v[3]);
+
+#endif

@@ -1,0 +1,481 @@
+/* Public entry points that add, read and change cloths. Each validates all of
+ * its input before touching the world, so a failed call changes nothing. */
+#include <math.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "buckling.h"
+#include "cloth.h"
+#include "material.h"
+#include "status.h"
+#include "world.h"
+
+#define MAX_VERTICES (1 << 26)
+#define MAX_FACES (1 << 27)
+
+wc_mesh_cloth_def wc_mesh_cloth_def_default(void)
+{
+    wc_mesh_cloth_def d;
+    memset(&d, 0, sizeof d);
+    d.face_size = 3;
+    d.material = wc_material_default();
+    return d;
+}
+
+wc_grid_cloth_def wc_grid_cloth_def_default(void)
+{
+    wc_grid_cloth_def d;
+    memset(&d, 0, sizeof d);
+    d.count_u = d.count_v = 32;
+    d.size_u = d.size_v = 1.0;
+    d.axis_u[0] = 1.0;
+    d.axis_v[1] = 1.0;
+    d.material = wc_material_default();
+    return d;
+}
+
+static wc_status append_cloth(wc_world *w, wc_cloth *c, int32_t *out_cloth)
+{
+    if (w->cloth_count == w->cloth_capacity) {
+        int32_t capacity = w->cloth_capacity ? 2 * w->cloth_capacity : 4;
+        wc_cloth **grown = wc_alloc_array((size_t)capacity, sizeof *grown);
+        if (!grown) {
+            wc_cloth_destroy(c);
+            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a cloth");
+        }
+        if (w->cloth_count) memcpy(grown, w->cloths, (size_t)w->cloth_count * sizeof *grown);
+        wc_free(w->cloths);
+        w->cloths = grown;
+        w->cloth_capacity = capacity;
+    }
+    w->cloths[w->cloth_count] = c;
+    *out_cloth = w->cloth_count++;
+    return WC_OK;
+}
+
+wc_status wc_world_add_mesh_cloth(wc_world *w, const wc_mesh_cloth_def *d, int32_t *out_cloth)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    wc_message *msg = &w->error;
+    if (!d || !out_cloth)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_mesh_cloth: %s is NULL",
+                       d ? "out_cloth" : "def");
+    if (d->vertex_count < 3 || d->vertex_count > MAX_VERTICES)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_cloth_def.vertex_count must be in [3, %d] but is %d", MAX_VERTICES,
+                       (int)d->vertex_count);
+    if (d->face_count < 1 || d->face_count > MAX_FACES)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_cloth_def.face_count must be in [1, %d] but is %d", MAX_FACES,
+                       (int)d->face_count);
+    if (d->face_size != 3 && d->face_size != 4)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_cloth_def.face_size must be 3 or 4 but is %d", (int)d->face_size);
+    if (!d->vertices || !d->faces)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "mesh_cloth_def.%s is NULL",
+                       d->vertices ? "faces" : "vertices");
+    wc_status s = wc_material_validate(&d->material, msg);
+    if (s) return s;
+    wc_cloth *c;
+    s = wc_cloth_create(&c, d->vertices, d->vertex_count, d->faces, d->face_count, d->face_size,
+                        &d->material, msg);
+    if (s) return s;
+    return append_cloth(w, c, out_cloth);
+}
+
+static wc_status validate_grid(const wc_grid_cloth_def *d, wc_message *msg)
+{
+    if (d->count_u < 2 || d->count_u > 32768 || d->count_v < 2 || d->count_v > 32768)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "grid_cloth_def.count_u and count_v must be in [2, 32768] but are %d and %d",
+                       (int)d->count_u, (int)d->count_v);
+    if ((int64_t)d->count_u * d->count_v > MAX_VERTICES)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "grid_cloth_def: count_u * count_v must be at most %d but is %lld",
+                       MAX_VERTICES, (long long)d->count_u * d->count_v);
+    if (!(isfinite(d->size_u) && d->size_u > 0 && d->size_u <= 1e6 && isfinite(d->size_v) &&
+          d->size_v > 0 && d->size_v <= 1e6))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "grid_cloth_def.size_u and size_v must be in (0, 1e6] m but are %g and %g",
+                       d->size_u, d->size_v);
+    double lu = 0, lv = 0, dot = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (!isfinite(d->center[k]))
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                           "grid_cloth_def.center[%d] must be finite but is %g", k, d->center[k]);
+        lu += d->axis_u[k] * d->axis_u[k];
+        lv += d->axis_v[k] * d->axis_v[k];
+        dot += d->axis_u[k] * d->axis_v[k];
+    }
+    if (!(fabs(lu - 1.0) <= 1e-6 && fabs(lv - 1.0) <= 1e-6 && fabs(dot) <= 1e-6))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "grid_cloth_def.axis_u and axis_v must be perpendicular unit vectors but "
+                       "have lengths %g and %g and dot product %g",
+                       sqrt(lu), sqrt(lv), dot);
+    return wc_material_validate(&d->material, msg);
+}
+
+wc_status wc_world_add_grid_cloth(wc_world *w, const wc_grid_cloth_def *d, int32_t *out_cloth)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    if (!d || !out_cloth)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_grid_cloth: %s is NULL",
+                       d ? "out_cloth" : "def");
+    wc_status s = validate_grid(d, &w->error);
+    if (s) return s;
+    int32_t nu = d->count_u, nv = d->count_v, n = nu * nv, quads = (nu - 1) * (nv - 1);
+    double *xyz = wc_alloc_array(3 * (size_t)n, sizeof *xyz);
+    int32_t *faces = wc_alloc_array(4 * (size_t)quads, sizeof *faces);
+    if (!xyz || !faces) {
+        wc_free(xyz);
+        wc_free(faces);
+        return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory building a %d x %d grid",
+                       (int)nu, (int)nv);
+    }
+    for (int32_t j = 0; j < nv; ++j)
+        for (int32_t i = 0; i < nu; ++i) {
+            double u = ((double)i / (nu - 1) - 0.5) * d->size_u;
+            double v = ((double)j / (nv - 1) - 0.5) * d->size_v;
+            for (int k = 0; k < 3; ++k)
+                xyz[3 * ((size_t)j * nu + i) + k] = d->center[k] + u * d->axis_u[k] + v * d->axis_v[k];
+        }
+    for (int32_t j = 0; j + 1 < nv; ++j)
+        for (int32_t i = 0; i + 1 < nu; ++i) {
+            int32_t *f = faces + 4 * ((size_t)j * (nu - 1) + i);
+            f[0] = j * nu + i;
+            f[1] = j * nu + i + 1;
+            f[2] = (j + 1) * nu + i + 1;
+            f[3] = (j + 1) * nu + i;
+        }
+    wc_cloth *c;
+    s = wc_cloth_create(&c, xyz, n, faces, quads, 4, &d->material, &w->error);
+    wc_free(xyz);
+    wc_free(faces);
+    if (s) return s;
+    return append_cloth(w, c, out_cloth);
+}
+
+/* Finds a cloth and checks that an array argument has the expected count. */
+static wc_cloth *cloth_with_count(const wc_world *w, int32_t cloth, const void *array,
+                                  int32_t count, int32_t expected, const char *caller)
+{
+    if (!w) return NULL;
+    wc_cloth *c = wc_world_find_cloth(w, cloth, caller);
+    if (!c) return NULL;
+    if (!array) {
+        wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT, "%s: the array is NULL", caller);
+        return NULL;
+    }
+    if (expected >= 0 && count != expected) {
+        wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+                "%s: count must be %d for cloth %d but is %d", caller, (int)expected, (int)cloth,
+                (int)count);
+        return NULL;
+    }
+    return c;
+}
+
+static wc_status lookup_status(const wc_world *w, int32_t cloth)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    return cloth >= 0 && cloth < w->cloth_count ? WC_ERROR_INVALID_ARGUMENT : WC_ERROR_NOT_FOUND;
+}
+
+int32_t wc_cloth_particle_count(const wc_world *w, int32_t cloth)
+{
+    return w && cloth >= 0 && cloth < w->cloth_count ? w->cloths[cloth]->particle_count : 0;
+}
+
+static const wc_link_set *link_set(const wc_cloth *c, wc_link_kind kind)
+{
+    if (kind == WC_LINK_STRETCH) return &c->topology.stretch;
+    if (kind == WC_LINK_BEND) return &c->topology.bend;
+    return NULL;
+}
+
+int32_t wc_cloth_link_count(const wc_world *w, int32_t cloth, wc_link_kind kind)
+{
+    if (!w || cloth < 0 || cloth >= w->cloth_count) return 0;
+    const wc_link_set *s = link_set(w->cloths[cloth], kind);
+    return s ? s->count : 0;
+}
+
+wc_status wc_cloth_get_links(const wc_world *w, int32_t cloth, wc_link_kind kind,
+                             int32_t *out_pairs, double *out_rest_lengths, int32_t capacity)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    wc_cloth *c = wc_world_find_cloth(w, cloth, "wc_cloth_get_links");
+    if (!c) return WC_ERROR_NOT_FOUND;
+    const wc_link_set *s = link_set(c, kind);
+    if (!s)
+        return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+                       "wc_cloth_get_links: kind must be WC_LINK_STRETCH (0) or WC_LINK_BEND (1) "
+                       "but is %d", (int)kind);
+    if (capacity < s->count)
+        return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+                       "wc_cloth_get_links: capacity must be at least %d but is %d", (int)s->count,
+                       (int)capacity);
+    for (int32_t e = 0; e < s->count; ++e) {
+        if (out_pairs) out_pairs[2 * e] = s->a[e], out_pairs[2 * e + 1] = s->b[e];
+        if (out_rest_lengths) out_rest_lengths[e] = s->rest[e];
+    }
+    return WC_OK;
+}
+
+int32_t wc_cloth_triangle_count(const wc_world *w, int32_t cloth)
+{
+    return w && cloth >= 0 && cloth < w->cloth_count ? w->cloths[cloth]->topology.triangle_count : 0;
+}
+
+wc_status wc_cloth_get_triangles(const wc_world *w, int32_t cloth, int32_t *out, int32_t capacity)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, out, capacity, -1, "wc_cloth_get_triangles");
+    if (!c) return lookup_status(w, cloth);
+    if (capacity < c->topology.triangle_count)
+        return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+                       "wc_cloth_get_triangles: capacity must be at least %d but is %d",
+                       (int)c->topology.triangle_count, (int)capacity);
+    memcpy(out, c->topology.triangles, 3 * (size_t)c->topology.triangle_count * sizeof *out);
+    return WC_OK;
+}
+
+wc_status wc_cloth_get_positions(const wc_world *w, int32_t cloth, double *out, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, out, count, wc_cloth_particle_count(w, cloth),
+                                   "wc_cloth_get_positions");
+    if (!c) return lookup_status(w, cloth);
+    for (int32_t i = 0; i < count; ++i) {
+        out[3 * (size_t)i] = c->x[i];
+        out[3 * (size_t)i + 1] = c->y[i];
+        out[3 * (size_t)i + 2] = c->z[i];
+    }
+    return WC_OK;
+}
+
+wc_status wc_cloth_get_positions_f32(const wc_world *w, int32_t cloth, float *out, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, out, count, wc_cloth_particle_count(w, cloth),
+                                   "wc_cloth_get_positions_f32");
+    if (!c) return lookup_status(w, cloth);
+    for (int32_t i = 0; i < count; ++i) {
+        out[3 * (size_t)i] = (float)c->x[i];
+        out[3 * (size_t)i + 1] = (float)c->y[i];
+        out[3 * (size_t)i + 2] = (float)c->z[i];
+    }
+    return WC_OK;
+}
+
+static wc_status check_finite_xyz(const wc_world *w, const double *xyz, int32_t count,
+                                  const char *caller)
+{
+    long bad = wc_first_non_finite(xyz, 3L * count);
+    if (bad < 0) return WC_OK;
+    return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+                   "%s: value %ld (%c of entry %ld) must be finite but is %g", caller, bad,
+                   "xyz"[bad % 3], bad / 3, xyz[bad]);
+}
+
+wc_status wc_cloth_set_positions(wc_world *w, int32_t cloth, const double *xyz, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, xyz, count, wc_cloth_particle_count(w, cloth),
+                                   "wc_cloth_set_positions");
+    if (!c) return lookup_status(w, cloth);
+    wc_status s = check_finite_xyz(w, xyz, count, "wc_cloth_set_positions");
+    if (s) return s;
+    for (int32_t i = 0; i < count; ++i) {
+        c->x[i] = xyz[3 * (size_t)i];
+        c->y[i] = xyz[3 * (size_t)i + 1];
+        c->z[i] = xyz[3 * (size_t)i + 2];
+        c->px[i] = c->py[i] = c->pz[i] = 0.0; /* velocity zero, see cloth.h */
+    }
+    c->has_history = 0;
+    for (int32_t p = 0; p < c->pins.count; ++p) {
+        int32_t i = c->pins.particle[p];
+        double *from = c->pins.from + 3 * (size_t)p, *to = c->pins.to + 3 * (size_t)p;
+        from[0] = to[0] = c->x[i];
+        from[1] = to[1] = c->y[i];
+        from[2] = to[2] = c->z[i];
+    }
+    return WC_OK;
+}
+
+wc_status wc_cloth_get_velocities(const wc_world *w, int32_t cloth, double *out, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, out, count, wc_cloth_particle_count(w, cloth),
+                                   "wc_cloth_get_velocities");
+    if (!c) return lookup_status(w, cloth);
+    for (int32_t i = 0; i < count; ++i) wc_cloth_velocity(c, i, out + 3 * (size_t)i);
+    return WC_OK;
+}
+
+wc_status wc_cloth_set_velocities(wc_world *w, int32_t cloth, const double *xyz, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, xyz, count, wc_cloth_particle_count(w, cloth),
+                                   "wc_cloth_set_velocities");
+    if (!c) return lookup_status(w, cloth);
+    wc_status s = check_finite_xyz(w, xyz, count, "wc_cloth_set_velocities");
+    if (s) return s;
+    for (int32_t i = 0; i < count; ++i) {
+        c->px[i] = xyz[3 * (size_t)i];
+        c->py[i] = xyz[3 * (size_t)i + 1];
+        c->pz[i] = xyz[3 * (size_t)i + 2];
+    }
+    c->has_history = 0;
+    return WC_OK;
+}
+
+wc_status wc_cloth_get_view(const wc_world *w, int32_t cloth, wc_cloth_view *out)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, out, 0, -1, "wc_cloth_get_view");
+    if (!c) return lookup_status(w, cloth);
+    out->particle_count = c->particle_count;
+    out->x = c->x;
+    out->y = c->y;
+    out->z = c->z;
+    out->mass = c->mass;
+    return WC_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Pins                                                                      */
+/* ------------------------------------------------------------------------ */
+
+/* Checks a pin list completely before anything changes: range, pinned
+ * already, repeated in the list. */
+static wc_status validate_pins(const wc_world *w, wc_cloth *c, const int32_t *idx, int32_t count)
+{
+    wc_message *msg = wc_world_message(w);
+    if (count < 0 || (int64_t)count + c->pins.count > c->particle_count)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_cloth_pin: count must be in [0, %d] (unpinned particles) but is %d",
+                       (int)(c->particle_count - c->pins.count), (int)count);
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t i = idx[k];
+        if (i < 0 || i >= c->particle_count)
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                           "wc_cloth_pin: indices[%d] is %d, but the cloth has %d particles",
+                           (int)k, (int)i, (int)c->particle_count);
+        if (c->pin_slot[i] >= 0)
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                           "wc_cloth_pin: indices[%d] = %d is %s", (int)k, (int)i,
+                           c->pin_slot[i] < c->pins.count ? "already pinned"
+                                                          : "repeated in the list");
+        c->pin_slot[i] = c->pins.count + k; /* marks it for the duplicate check */
+    }
+    return WC_OK;
+}
+
+static void undo_pin_marks(wc_cloth *c, const int32_t *idx, int32_t count)
+{
+    for (int32_t k = 0; k < count; ++k)
+        if (idx[k] >= 0 && idx[k] < c->particle_count && c->pin_slot[idx[k]] >= c->pins.count)
+            c->pin_slot[idx[k]] = -1;
+}
+
+wc_status wc_cloth_pin(wc_world *w, int32_t cloth, const int32_t *idx, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, idx, count, -1, "wc_cloth_pin");
+    if (!c) return lookup_status(w, cloth);
+    wc_status s = validate_pins(w, c, idx, count);
+    int32_t total = c->pins.count + count;
+    int32_t *particle = NULL;
+    double *from = NULL, *to = NULL;
+    if (!s) {
+        particle = wc_alloc_array((size_t)total, sizeof *particle);
+        from = wc_alloc_array(3 * (size_t)total, sizeof *from);
+        to = wc_alloc_array(3 * (size_t)total, sizeof *to);
+        if (!particle || !from || !to)
+            s = wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory pinning %d particles",
+                        (int)count);
+    }
+    if (s) {
+        undo_pin_marks(c, idx, count);
+        wc_free(particle);
+        wc_free(from);
+        wc_free(to);
+        return s;
+    }
+    if (c->pins.count) {
+        memcpy(particle, c->pins.particle, (size_t)c->pins.count * sizeof *particle);
+        memcpy(from, c->pins.from, 3 * (size_t)c->pins.count * sizeof *from);
+        memcpy(to, c->pins.to, 3 * (size_t)c->pins.count * sizeof *to);
+    }
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t p = c->pins.count + k, i = idx[k];
+        particle[p] = i;
+        from[3 * p] = to[3 * p] = c->x[i];
+        from[3 * p + 1] = to[3 * p + 1] = c->y[i];
+        from[3 * p + 2] = to[3 * p + 2] = c->z[i];
+    }
+    wc_free(c->pins.particle);
+    wc_free(c->pins.from);
+    wc_free(c->pins.to);
+    c->pins.particle = particle;
+    c->pins.from = from;
+    c->pins.to = to;
+    c->pins.count = total;
+    return WC_OK;
+}
+
+wc_status wc_cloth_unpin_all(wc_world *w, int32_t cloth)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    wc_cloth *c = wc_world_find_cloth(w, cloth, "wc_cloth_unpin_all");
+    if (!c) return WC_ERROR_NOT_FOUND;
+    for (int32_t p = 0; p < c->pins.count; ++p) c->pin_slot[c->pins.particle[p]] = -1;
+    c->pins.count = 0;
+    return WC_OK;
+}
+
+int32_t wc_cloth_pin_count(const wc_world *w, int32_t cloth)
+{
+    return w && cloth >= 0 && cloth < w->cloth_count ? w->cloths[cloth]->pins.count : 0;
+}
+
+wc_status wc_cloth_set_pin_targets(wc_world *w, int32_t cloth, const double *xyz, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, xyz, count, wc_cloth_pin_count(w, cloth),
+                                   "wc_cloth_set_pin_targets");
+    if (!c) return lookup_status(w, cloth);
+    wc_status s = check_finite_xyz(w, xyz, count, "wc_cloth_set_pin_targets");
+    if (s) return s;
+    memcpy(c->pins.to, xyz, 3 * (size_t)count * sizeof *xyz);
+    return WC_OK;
+}
+
+double wc_cloth_stable_dt(const wc_world *w, int32_t cloth)
+{
+    return w && cloth >= 0 && cloth < w->cloth_count ? w->cloths[cloth]->stable_dt : 0.0;
+}
+
+wc_status wc_cloth_get_energy(const wc_world *w, int32_t cloth, wc_energy *out)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, out, 0, -1, "wc_cloth_get_energy");
+    if (!c) return lookup_status(w, cloth);
+    const double *g = w->def.gravity;
+    const wc_topology *t = &c->topology;
+    wc_energy e = {0.0, 0.0, 0.0, 0.0};
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        double v[3];
+        wc_cloth_velocity(c, i, v);
+        e.kinetic += 0.5 * c->mass[i] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        e.gravity -= c->mass[i] * (g[0] * c->x[i] + g[1] * c->y[i] + g[2] * c->z[i]);
+    }
+    for (int32_t k = 0; k < t->stretch.count; ++k) {
+        int32_t a = t->stretch.a[k], b = t->stretch.b[k];
+        double d = sqrt((c->x[a] - c->x[b]) * (c->x[a] - c->x[b]) +
+                        (c->y[a] - c->y[b]) * (c->y[a] - c->y[b]) +
+                        (c->z[a] - c->z[b]) * (c->z[a] - c->z[b]));
+        if (d > t->stretch.rest[k])
+            e.stretch += 0.5 * c->stretch_k[k] * (d - t->stretch.rest[k]) * (d - t->stretch.rest[k]);
+    }
+    for (int32_t k = 0; k < t->bend.count; ++k) {
+        int32_t a = t->bend.a[k], b = t->bend.b[k];
+        double d = sqrt((c->x[a] - c->x[b]) * (c->x[a] - c->x[b]) +
+                        (c->y[a] - c->y[b]) * (c->y[a] - c->y[b]) +
+                        (c->z[a] - c->z[b]) * (c->z[a] - c->z[b]));
+        e.bend += wc_buckling_energy(d, t->bend.rest[k], c->bend_r[k]);
+    }
+    *out = e;
+    return WC_OK;
+}

@@ -1,0 +1,13 @@
+/* Forces on a cloth's particles (SPEC 1.3): tension-only stretch links with
+ * damping, compression-only buckling links, gravity and air drag. */
+#ifndef WC_FORCES_H
+#define WC_FORCES_H
+
+#include "cloth.h"
+
+/// Fills cloth->fx/fy/fz with the total force on every particle, N.
+/// Each link's force is computed once, then every particle sums its own
+/// links in a fixed order: no two threads ever write the same value.
+void wc_forces_compute(wc_cloth *cloth, const double gravity[3], int threads);
+
+#endif

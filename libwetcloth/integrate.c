@@ -1,0 +1,46 @@
+#include "integrate.h"
+
+#include <math.h>
+
+#include "parallel.h"
+
+static void pinned_position(const wc_cloth *c, int32_t slot, double fraction, double out[3])
+{
+    const double *from = c->pins.from + 3 * (size_t)slot, *to = c->pins.to + 3 * (size_t)slot;
+    for (int k = 0; k < 3; ++k) out[k] = fraction == 1.0 ? to[k] : from[k] + (to[k] - from[k]) * fraction;
+}
+
+int32_t wc_integrate_verlet(wc_cloth *c, double dt, double pin_fraction, int threads)
+{
+    int32_t n = c->particle_count;
+    int first = !c->has_history;
+    /* x(t+dt) = x + (x - x_prev) * dt/dt_prev + a dt^2: Verlet, with the
+     * history rescaled when the step length changes. The first step starts
+     * from the velocity v held in px: x + v dt + a dt^2 / 2, which is what
+     * makes free fall exact to rounding. */
+    double ratio = first ? dt : dt / c->dt_prev;
+    double acc_scale = first ? 0.5 * dt * dt : dt * dt;
+    int bad = 0;
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN) \
+    reduction(|| : bad)
+    for (int32_t i = 0; i < n; ++i) {
+        double p[3];
+        if (c->pin_slot[i] >= 0) {
+            pinned_position(c, c->pin_slot[i], pin_fraction, p);
+        } else {
+            double s = c->inv_mass[i] * acc_scale;
+            double mx = first ? c->px[i] : c->x[i] - c->px[i];
+            double my = first ? c->py[i] : c->y[i] - c->py[i];
+            double mz = first ? c->pz[i] : c->z[i] - c->pz[i];
+            p[0] = c->x[i] + mx * ratio + c->fx[i] * s;
+            p[1] = c->y[i] + my * ratio + c->fy[i] * s;
+            p[2] = c->z[i] + mz * ratio + c->fz[i] * s;
+        }
+        c->nx[i] = p[0], c->ny[i] = p[1], c->nz[i] = p[2];
+        bad = bad || !(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]));
+    }
+    if (!bad) return -1;
+    for (int32_t i = 0; i < n; ++i)
+        if (!(isfinite(c->nx[i]) && isfinite(c->ny[i]) && isfinite(c->nz[i]))) return i;
+    return -1;
+}

@@ -1,0 +1,37 @@
+#include "material.h"
+
+#include <math.h>
+
+#include "status.h"
+
+wc_material wc_material_default(void)
+{
+    wc_material m;
+    m.density = 0.15;
+    m.stretch_stiffness = 1000.0;
+    m.bend_stiffness = 1e-5;
+    m.stretch_damping = 0.05;
+    m.air_drag = 0.02;
+    return m;
+}
+
+static wc_status check_range(wc_message *msg, const char *field, double value, double lo,
+                             double hi, int lo_open)
+{
+    int ok = isfinite(value) && (lo_open ? value > lo : value >= lo) && value <= hi;
+    if (ok) return WC_OK;
+    return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                   "material.%s must be in %s%g, %g] but is %g", field, lo_open ? "(" : "[",
+                   lo, hi, value);
+}
+
+wc_status wc_material_validate(const wc_material *m, wc_message *msg)
+{
+    wc_status s;
+    if ((s = check_range(msg, "density", m->density, 0.0, 1e3, 1))) return s;
+    if ((s = check_range(msg, "stretch_stiffness", m->stretch_stiffness, 0.0, 1e9, 0))) return s;
+    if ((s = check_range(msg, "bend_stiffness", m->bend_stiffness, 0.0, 1e3, 0))) return s;
+    if ((s = check_range(msg, "stretch_damping", m->stretch_damping, 0.0, 1.0, 0))) return s;
+    if ((s = check_range(msg, "air_drag", m->air_drag, 0.0, 1e4, 0))) return s;
+    return WC_OK;
+}

@@ -1,0 +1,336 @@
+#include "topology.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "status.h"
+
+/* One link candidate before duplicates are merged. `order` makes the sort a
+ * total order, so merged sums are added in the same order on every run. */
+typedef struct link_entry {
+    int32_t a, b;
+    int32_t order;
+    double share;
+} link_entry;
+
+static int compare_entries(const void *pa, const void *pb)
+{
+    const link_entry *p = pa, *q = pb;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    if (p->b != q->b) return p->b < q->b ? -1 : 1;
+    return (p->order > q->order) - (p->order < q->order);
+}
+
+static void vertex(const double *xyz, int32_t i, double out[3])
+{
+    out[0] = xyz[3 * (size_t)i];
+    out[1] = xyz[3 * (size_t)i + 1];
+    out[2] = xyz[3 * (size_t)i + 2];
+}
+
+static double distance(const double *xyz, int32_t i, int32_t j)
+{
+    double p[3], q[3];
+    vertex(xyz, i, p);
+    vertex(xyz, j, q);
+    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                (p[2] - q[2]) * (p[2] - q[2]));
+}
+
+/* Area of triangle (i, j, k) and the square of its longest edge. */
+static double triangle_area(const double *xyz, int32_t i, int32_t j, int32_t k, double *longest2)
+{
+    double p[3], q[3], r[3], u[3], v[3], n[3];
+    vertex(xyz, i, p);
+    vertex(xyz, j, q);
+    vertex(xyz, k, r);
+    for (int c = 0; c < 3; ++c) {
+        u[c] = q[c] - p[c];
+        v[c] = r[c] - p[c];
+    }
+    n[0] = u[1] * v[2] - u[2] * v[1];
+    n[1] = u[2] * v[0] - u[0] * v[2];
+    n[2] = u[0] * v[1] - u[1] * v[0];
+    double e0 = distance(xyz, i, j), e1 = distance(xyz, j, k), e2 = distance(xyz, k, i);
+    double m = fmax(e0, fmax(e1, e2));
+    *longest2 = m * m;
+    return 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+/* Checks one face and returns its corner count (3 or 4) and area. */
+static wc_status check_face(const double *xyz, int32_t n, const int32_t *face, int32_t face_size,
+                            int32_t index, int32_t *corners, double *area, wc_message *msg)
+{
+    int32_t m = face_size;
+    if (face_size == 4 && face[3] == -1) m = 3;
+    for (int32_t c = 0; c < m; ++c) {
+        if (face[c] < 0 || face[c] >= n)
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                           "cloth face %d uses vertex %d, but the cloth has %d vertices (valid: 0..%d%s)",
+                           (int)index, (int)face[c], (int)n, (int)n - 1,
+                           face_size == 4 && c == 3 ? ", or -1 to make a triangle" : "");
+        for (int32_t d = 0; d < c; ++d)
+            if (face[d] == face[c])
+                return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                               "cloth face %d uses vertex %d twice", (int)index, (int)face[c]);
+    }
+    /* A face is degenerate when its area is negligible next to its size; for
+     * a quad each of its two triangles must be sound, since both carry mass
+     * and links. */
+    double l0, l1 = 0.0;
+    double a0 = triangle_area(xyz, face[0], face[1], face[2], &l0);
+    double a1 = m == 4 ? triangle_area(xyz, face[0], face[2], face[3], &l1) : 0.0;
+    if (!(a0 > 1e-12 * l0) || (m == 4 && !(a1 > 1e-12 * l1)))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "cloth face %d is degenerate: its vertices are collinear or coincide "
+                       "(area %g m^2)", (int)index, a0 + a1);
+    *corners = m;
+    *area = a0 + a1;
+    return WC_OK;
+}
+
+static void link_set_free(wc_link_set *s)
+{
+    wc_free(s->a);
+    wc_free(s->b);
+    wc_free(s->rest);
+    wc_free(s->share);
+    memset(s, 0, sizeof *s);
+}
+
+static int link_set_alloc(wc_link_set *s, int32_t count)
+{
+    s->count = count;
+    s->a = wc_alloc_array((size_t)count, sizeof *s->a);
+    s->b = wc_alloc_array((size_t)count, sizeof *s->b);
+    s->rest = wc_alloc_array((size_t)count, sizeof *s->rest);
+    s->share = wc_alloc_array((size_t)count, sizeof *s->share);
+    if (s->a && s->b && s->rest && s->share) return 1;
+    link_set_free(s);
+    return 0;
+}
+
+/* Sorts entries and merges duplicates (summing shares) into a link set. */
+static wc_status merge_entries(link_entry *entries, size_t count, const double *xyz,
+                               wc_link_set *out)
+{
+    qsort(entries, count, sizeof *entries, compare_entries);
+    size_t unique = 0;
+    for (size_t i = 0; i < count; ++i)
+        if (i == 0 || entries[i].a != entries[i - 1].a || entries[i].b != entries[i - 1].b)
+            entries[unique++] = entries[i];
+        else
+            entries[unique - 1].share += entries[i].share;
+    if (!link_set_alloc(out, (int32_t)unique)) return WC_ERROR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < unique; ++i) {
+        out->a[i] = entries[i].a;
+        out->b[i] = entries[i].b;
+        out->rest[i] = distance(xyz, entries[i].a, entries[i].b);
+        out->share[i] = entries[i].share;
+    }
+    return WC_OK;
+}
+
+static void add_entry(link_entry *e, size_t *count, int32_t i, int32_t j, double share)
+{
+    link_entry *x = &e[*count];
+    x->a = i < j ? i : j;
+    x->b = i < j ? j : i;
+    x->order = (int32_t)*count;
+    x->share = share;
+    ++*count;
+}
+
+/* Stretch links: every face's edges, plus both diagonals of each quad. Each
+ * face shares its area, times its calibration factor, equally among its links
+ * (see wc_material for why 8/3 and 12/5). */
+static wc_status build_stretch(wc_topology *t, const double *xyz, const int32_t *faces,
+                               int32_t face_count, int32_t face_size, const int32_t *corners,
+                               const double *face_area)
+{
+    link_entry *e = wc_alloc_array((size_t)face_count * 6, sizeof *e);
+    if (!e) return WC_ERROR_OUT_OF_MEMORY;
+    size_t count = 0;
+    for (int32_t f = 0; f < face_count; ++f) {
+        const int32_t *v = faces + (size_t)f * face_size;
+        if (corners[f] == 3) {
+            double s = (8.0 / 3.0) * face_area[f] / 3.0;
+            add_entry(e, &count, v[0], v[1], s);
+            add_entry(e, &count, v[1], v[2], s);
+            add_entry(e, &count, v[2], v[0], s);
+        } else {
+            double s = (12.0 / 5.0) * face_area[f] / 6.0;
+            for (int c = 0; c < 4; ++c) add_entry(e, &count, v[c], v[(c + 1) % 4], s);
+            add_entry(e, &count, v[0], v[2], s);
+            add_entry(e, &count, v[1], v[3], s);
+        }
+    }
+    wc_status s = merge_entries(e, count, xyz, &t->stretch);
+    wc_free(e);
+    return s;
+}
+
+/* Neighbours of each particle along stretch links, as CSR. */
+static wc_status neighbours(const wc_link_set *links, int32_t n, int32_t **start_out,
+                            int32_t **list_out)
+{
+    int32_t *start = wc_alloc_array((size_t)n + 1, sizeof *start);
+    int32_t *list = wc_alloc_array((size_t)links->count * 2, sizeof *list);
+    int32_t *fill = wc_alloc_array((size_t)n, sizeof *fill);
+    if (!start || !list || !fill) {
+        wc_free(start);
+        wc_free(list);
+        wc_free(fill);
+        return WC_ERROR_OUT_OF_MEMORY;
+    }
+    for (int32_t e = 0; e < links->count; ++e) {
+        start[links->a[e] + 1]++;
+        start[links->b[e] + 1]++;
+    }
+    for (int32_t i = 0; i < n; ++i) start[i + 1] += start[i];
+    for (int32_t e = 0; e < links->count; ++e) {
+        int32_t a = links->a[e], b = links->b[e];
+        list[start[a] + fill[a]++] = b;
+        list[start[b] + fill[b]++] = a;
+    }
+    wc_free(fill);
+    *start_out = start;
+    *list_out = list;
+    return WC_OK;
+}
+
+static int nearly_straight(const double *xyz, int32_t a, int32_t b, int32_t c)
+{
+    double p[3], q[3], r[3], dot = 0.0, la = 0.0, lc = 0.0;
+    vertex(xyz, a, p);
+    vertex(xyz, b, q);
+    vertex(xyz, c, r);
+    for (int k = 0; k < 3; ++k) {
+        dot += (p[k] - q[k]) * (r[k] - q[k]);
+        la += (p[k] - q[k]) * (p[k] - q[k]);
+        lc += (r[k] - q[k]) * (r[k] - q[k]);
+    }
+    return dot <= WC_BEND_COS_LIMIT * sqrt(la * lc);
+}
+
+/* Bend links (SPEC 1.2): (a, c) when (a, b) and (b, c) are stretch links and
+ * the rest angle a-b-c is at least 150 degrees. On a grid this is exactly the
+ * thesis' "skip one" set: the only neighbour pairs of b that are that
+ * straight are opposite ones (the next straightest pair is at 135 degrees). */
+static wc_status build_bend(wc_topology *t, const double *xyz)
+{
+    int32_t n = t->particle_count, *start, *list;
+    wc_status s = neighbours(&t->stretch, n, &start, &list);
+    if (s) return s;
+    size_t count = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        link_entry *e = NULL;
+        if (pass == 1) {
+            e = wc_alloc_array(count, sizeof *e);
+            if (!e) {
+                s = WC_ERROR_OUT_OF_MEMORY;
+                break;
+            }
+            count = 0;
+        }
+        for (int32_t b = 0; b < n; ++b)
+            for (int32_t i = start[b]; i < start[b + 1]; ++i)
+                for (int32_t j = i + 1; j < start[b + 1]; ++j)
+                    if (nearly_straight(xyz, list[i], b, list[j])) {
+                        if (e) add_entry(e, &count, list[i], list[j], 0.0);
+                        else ++count;
+                    }
+        if (pass == 1) {
+            s = merge_entries(e, count, xyz, &t->bend);
+            wc_free(e);
+        }
+    }
+    wc_free(start);
+    wc_free(list);
+    if (s) return s;
+    /* Each particle's area is shared equally among its bend links. */
+    int32_t *degree = wc_alloc_array((size_t)n, sizeof *degree);
+    if (!degree) return WC_ERROR_OUT_OF_MEMORY;
+    for (int32_t k = 0; k < t->bend.count; ++k) {
+        degree[t->bend.a[k]]++;
+        degree[t->bend.b[k]]++;
+    }
+    for (int32_t k = 0; k < t->bend.count; ++k)
+        t->bend.share[k] = t->area[t->bend.a[k]] / degree[t->bend.a[k]] +
+                           t->area[t->bend.b[k]] / degree[t->bend.b[k]];
+    wc_free(degree);
+    return WC_OK;
+}
+
+static void build_triangles(wc_topology *t, const int32_t *faces, int32_t face_count,
+                            int32_t face_size, const int32_t *corners)
+{
+    int32_t k = 0;
+    for (int32_t f = 0; f < face_count; ++f) {
+        const int32_t *v = faces + (size_t)f * face_size;
+        int32_t *out = t->triangles + 3 * (size_t)k;
+        out[0] = v[0], out[1] = v[1], out[2] = v[2];
+        ++k;
+        if (corners[f] == 4) {
+            out += 3;
+            out[0] = v[0], out[1] = v[2], out[2] = v[3];
+            ++k;
+        }
+    }
+}
+
+wc_status wc_topology_build(wc_topology *t, const double *xyz, int32_t n, const int32_t *faces,
+                            int32_t face_count, int32_t face_size, wc_message *msg)
+{
+    memset(t, 0, sizeof *t);
+    t->particle_count = n;
+    long bad = wc_first_non_finite(xyz, 3L * n);
+    if (bad >= 0)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "cloth vertex %ld has a non-finite coordinate (%c = %g)", bad / 3,
+                       "xyz"[bad % 3], xyz[bad]);
+
+    int32_t *corners = wc_alloc_array((size_t)face_count, sizeof *corners);
+    double *face_area = wc_alloc_array((size_t)face_count, sizeof *face_area);
+    t->area = wc_alloc_array((size_t)n, sizeof *t->area);
+    wc_status s = (corners && face_area && t->area) ? WC_OK : WC_ERROR_OUT_OF_MEMORY;
+    int32_t triangles = 0;
+    for (int32_t f = 0; f < face_count && !s; ++f) {
+        const int32_t *v = faces + (size_t)f * face_size;
+        s = check_face(xyz, n, v, face_size, f, &corners[f], &face_area[f], msg);
+        if (s) break;
+        triangles += corners[f] - 2;
+        for (int32_t c = 0; c < corners[f]; ++c) t->area[v[c]] += face_area[f] / corners[f];
+    }
+    for (int32_t i = 0; i < n && !s; ++i)
+        if (t->area[i] == 0.0)
+            s = wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                        "cloth vertex %d belongs to no face (every vertex needs a face to have mass)",
+                        (int)i);
+    if (!s) s = build_stretch(t, xyz, faces, face_count, face_size, corners, face_area);
+    if (!s) s = build_bend(t, xyz);
+    if (!s) {
+        t->triangle_count = triangles;
+        t->triangles = wc_alloc_array((size_t)triangles * 3, sizeof *t->triangles);
+        if (t->triangles) build_triangles(t, faces, face_count, face_size, corners);
+        else s = WC_ERROR_OUT_OF_MEMORY;
+    }
+    wc_free(corners);
+    wc_free(face_area);
+    if (s == WC_ERROR_OUT_OF_MEMORY)
+        wc_fail(msg, s, "out of memory while building the topology of a cloth of %d vertices",
+                (int)n);
+    if (s) wc_topology_free(t);
+    return s;
+}
+
+void wc_topology_free(wc_topology *t)
+{
+    wc_free(t->area);
+    link_set_free(&t->stretch);
+    link_set_free(&t->bend);
+    wc_free(t->triangles);
+    memset(t, 0, sizeof *t);
+}

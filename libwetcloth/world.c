@@ -1,0 +1,192 @@
+#include "world.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "forces.h"
+#include "integrate.h"
+#include "parallel.h"
+#include "status.h"
+
+int32_t wc_version(void) { return WC_VERSION; }
+
+const char *wc_version_string(void)
+{
+#define WC_STR2(x) #x
+#define WC_STR(x) WC_STR2(x)
+    return WC_STR(WC_VERSION_MAJOR) "." WC_STR(WC_VERSION_MINOR) "." WC_STR(WC_VERSION_PATCH);
+}
+
+wc_world_def wc_world_def_default(void)
+{
+    wc_world_def d;
+    memset(&d, 0, sizeof d);
+    d.gravity[2] = -9.81;
+    d.thread_count = 0;
+    d.integrator = WC_INTEGRATOR_VERLET;
+    d.substep_safety = 0.9;
+    d.max_substeps = 100000;
+    return d;
+}
+
+static wc_status validate_world_def(const wc_world_def *d, wc_message *msg)
+{
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(d->gravity[k]))
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                           "world_def.gravity[%d] must be finite but is %g", k, d->gravity[k]);
+    if (d->thread_count < 0 || d->thread_count > 1024)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "world_def.thread_count must be in [0, 1024] (0 = OpenMP default) but is %d",
+                       (int)d->thread_count);
+    if (d->integrator != WC_INTEGRATOR_VERLET)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "world_def.integrator must be WC_INTEGRATOR_VERLET (0) but is %d",
+                       (int)d->integrator);
+    if (!(d->substep_safety > 0.0 && d->substep_safety <= 1.0))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "world_def.substep_safety must be in (0, 1] but is %g", d->substep_safety);
+    if (d->max_substeps < 1 || d->max_substeps > 10000000)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "world_def.max_substeps must be in [1, 10000000] but is %d",
+                       (int)d->max_substeps);
+    return WC_OK;
+}
+
+wc_status wc_world_create(const wc_world_def *def, wc_world **out_world, wc_message *out_message)
+{
+    if (out_message) out_message->text[0] = '\0';
+    if (!out_world)
+        return wc_fail(out_message, WC_ERROR_INVALID_ARGUMENT, "wc_world_create: out_world is NULL");
+    *out_world = NULL;
+    if (!def)
+        return wc_fail(out_message, WC_ERROR_INVALID_ARGUMENT, "wc_world_create: def is NULL");
+    wc_status s = validate_world_def(def, out_message);
+    if (s) return s;
+    wc_world *w = wc_alloc_array(1, sizeof *w);
+    if (!w) return wc_fail(out_message, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a world");
+    w->def = *def;
+    *out_world = w;
+    return WC_OK;
+}
+
+void wc_world_destroy(wc_world *w)
+{
+    if (!w) return;
+    for (int32_t i = 0; i < w->cloth_count; ++i) wc_cloth_destroy(w->cloths[i]);
+    wc_free(w->cloths);
+    wc_free(w);
+}
+
+wc_message *wc_world_message(const wc_world *w) { return (wc_message *)&w->error; }
+
+const char *wc_world_last_error(const wc_world *w) { return w ? w->error.text : "world is NULL"; }
+
+wc_cloth *wc_world_find_cloth(const wc_world *w, int32_t cloth, const char *caller)
+{
+    if (cloth >= 0 && cloth < w->cloth_count) return w->cloths[cloth];
+    wc_fail(wc_world_message(w), WC_ERROR_NOT_FOUND, "%s: cloth %d does not exist (the world has %d)",
+            caller, (int)cloth, (int)w->cloth_count);
+    return NULL;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Stepping                                                                  */
+/* ------------------------------------------------------------------------ */
+
+/* One step of the whole world, top to bottom: forces, integration,
+ * (collisions and the wet response come in here), commit. Nothing is
+ * committed unless every cloth's new state is finite. */
+static wc_status world_step(wc_world *w, double dt, double pin_fraction)
+{
+    int threads = wc_thread_count(w->def.thread_count);
+    for (int32_t c = 0; c < w->cloth_count; ++c)
+        wc_forces_compute(w->cloths[c], w->def.gravity, threads);
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
+        int32_t bad = wc_integrate_verlet(w->cloths[c], dt, pin_fraction, threads);
+        if (bad >= 0)
+            return wc_fail(&w->error, WC_ERROR_NON_FINITE,
+                           "step of %g s would move particle %d of cloth %d to a non-finite "
+                           "position; the stable step is about %g s. The world keeps its last "
+                           "good state", dt, (int)bad, (int)c, w->cloths[c]->stable_dt);
+    }
+    for (int32_t c = 0; c < w->cloth_count; ++c) wc_cloth_commit(w->cloths[c], dt);
+    w->time += dt;
+    return WC_OK;
+}
+
+/* After an advance (complete or not) the pins start the next one from where
+ * they are. */
+static void settle_pins(wc_world *w)
+{
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
+        wc_cloth *cl = w->cloths[c];
+        for (int32_t p = 0; p < cl->pins.count; ++p) {
+            int32_t i = cl->pins.particle[p];
+            double *from = cl->pins.from + 3 * (size_t)p, *to = cl->pins.to + 3 * (size_t)p;
+            from[0] = to[0] = cl->x[i];
+            from[1] = to[1] = cl->y[i];
+            from[2] = to[2] = cl->z[i];
+        }
+    }
+}
+
+static wc_status check_step_length(wc_world *w, const char *name, double dt)
+{
+    if (!(isfinite(dt) && dt > 0.0 && dt <= 10.0))
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "%s must be in (0, 10] s but is %g",
+                       name, dt);
+    return WC_OK;
+}
+
+wc_status wc_world_step(wc_world *w, double dt)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    wc_status s = check_step_length(w, "wc_world_step: dt", dt);
+    if (s) return s;
+    s = world_step(w, dt, 1.0);
+    settle_pins(w);
+    return s;
+}
+
+double wc_world_stable_dt(const wc_world *w)
+{
+    double dt = INFINITY;
+    if (!w) return dt;
+    for (int32_t c = 0; c < w->cloth_count; ++c)
+        if (w->cloths[c]->stable_dt < dt) dt = w->cloths[c]->stable_dt;
+    return dt;
+}
+
+wc_status wc_world_advance(wc_world *w, double frame_dt, int32_t substeps)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    wc_status s = check_step_length(w, "wc_world_advance: frame_dt", frame_dt);
+    if (s) return s;
+    if (substeps < 0 || substeps > w->def.max_substeps)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_world_advance: substeps must be in [0, %d] (0 = automatic) but is %d",
+                       (int)w->def.max_substeps, (int)substeps);
+    if (substeps == 0) {
+        double needed = ceil(frame_dt / (w->def.substep_safety * wc_world_stable_dt(w)));
+        if (needed > w->def.max_substeps)
+            return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                           "wc_world_advance: a frame of %g s needs %.0f substeps at the stable "
+                           "step %g s, more than world_def.max_substeps = %d",
+                           frame_dt, needed, wc_world_stable_dt(w), (int)w->def.max_substeps);
+        substeps = needed < 1.0 ? 1 : (int32_t)needed;
+    }
+    double dt = frame_dt / substeps;
+    for (int32_t k = 0; k < substeps && !s; ++k)
+        s = world_step(w, dt, (double)(k + 1) / substeps);
+    settle_pins(w);
+    w->last_substeps = substeps;
+    return s;
+}
+
+int32_t wc_world_last_substeps(const wc_world *w) { return w ? w->last_substeps : 0; }
+
+double wc_world_time(const wc_world *w) { return w ? w->time : 0.0; }
+
+int32_t wc_world_cloth_count(const wc_world *w) { return w ? w->cloth_count : 0; }

@@ -1,0 +1,26 @@
+#ifndef WC_WORLD_H
+#define WC_WORLD_H
+
+#include "cloth.h"
+#include "wetcloth.h"
+
+struct wc_world {
+    wc_world_def def;
+    wc_cloth **cloths;
+    int32_t cloth_count;
+    int32_t cloth_capacity;
+    double time;
+    int32_t last_substeps;
+    /// Message of the last failed call. Calls that take a const world still
+    /// report here: the world itself is never const-defined (it comes from
+    /// wc_world_create), so writing through a cast pointer is well defined.
+    wc_message error;
+};
+
+/// The world's message buffer, writable from const entry points.
+wc_message *wc_world_message(const wc_world *world);
+
+/// The cloth at an index, or NULL after reporting WC_ERROR_NOT_FOUND.
+wc_cloth *wc_world_find_cloth(const wc_world *world, int32_t cloth, const char *caller);
+
+#endif
