@@ -96,13 +96,6 @@ double wc_buckling_phi(double theta)
     return 4.0 / q;
 }
 
-double wc_buckling_force(double d, double l, double R)
-{
-    if (!(d < l)) return 0.0;
-    double gap = (l - d) / l; /* l - d is exact when d is near l (Sterbenz) */
-    return R / (l * l) * wc_buckling_phi(wc_inverse_sinc_gap(gap));
-}
-
 double wc_buckling_energy(double d, double l, double R)
 {
     if (!(d < l)) return 0.0;
