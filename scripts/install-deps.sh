@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Installs the Debian/Ubuntu packages libwetcloth needs to build and test,
+# only those that are missing. Runs apt-get only when something is missing;
+# uses sudo when not root (and sudo exists). Called by setup.sh and test.sh.
+set -euo pipefail
+
+packages=(cmake ninja-build gcc libc6-dev libccd-dev pkg-config python3-venv)
+
+missing=()
+for p in "${packages[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+        missing+=("$p")
+    fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+    echo "install-deps: all packages present (${packages[*]})"
+    exit 0
+fi
+
+if ! command -v apt-get >/dev/null 2>&1; then
+    echo "install-deps: missing ${missing[*]}, and there is no apt-get here." >&2
+    echo "Install the equivalents of: ${missing[*]} (CMake >= 3.20, a C99 compiler with" >&2
+    echo "OpenMP, libccd 2 with its CMake config, pkg-config), then run this again." >&2
+    exit 1
+fi
+
+sudo=()
+if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null 2>&1; then
+        sudo=(sudo)
+    else
+        echo "install-deps: missing ${missing[*]}; not root and no sudo." >&2
+        echo "As root run: apt-get update && apt-get install -y ${missing[*]}" >&2
+        exit 1
+    fi
+fi
+
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" apt-get update -q
+"${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
