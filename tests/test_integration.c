@@ -376,10 +376,10 @@ static void test_energy_conservation(void)
  *    stable step scale like 1/sqrt(S)).
  *  - bend_stiffness 0: a buckling link resists the in-plane (Poisson)
  *    contraction of the hanging sheet with a force that jumps to 12 R/l^2
- *    at onset; with R ~ B l this resistance per unit width grows like 1/l
- *    under refinement, so with bending on the drape depends on the
- *    resolution through the bend links (see the report) and the stretch
- *    model's convergence is not what is measured.
+ *    at onset; with R ~ B l this resistance per unit width grows like 1/l^2
+ *    under refinement, so with bending on the drape changes with the
+ *    resolution through the bend links. That is checked separately below
+ *    (test_hanging_default_bending); here the stretch model is measured.
  *  - stretch_damping 0.3 and air_drag 1.5 N s/m^3: near-critical damping of
  *    the first longitudinal mode, which settles the sheet within seconds;
  *    neither changes the static equilibrium.
@@ -387,11 +387,12 @@ static void test_energy_conservation(void)
  * interpolation of the displacement) and must relax from there for at least
  * 1 s: the same equilibrium, reached in a third of the steps. */
 typedef struct hang_result {
-    double bottom_drop, mean_drop, settle_time, kinetic, seconds;
+    double bottom_drop, mean_drop, bottom_width, settle_time, kinetic, seconds;
     int32_t substeps;
 } hang_result;
 
-static hang_result hang_cloth(int32_t cells, const double *coarse_disp, double **out_disp)
+static hang_result hang_cloth(int32_t cells, double bend_stiffness, double max_time,
+                              int require_settled, const double *coarse_disp, double **out_disp)
 {
     const double grav[3] = {0.0, 0.0, -9.81};
     /* one thread: results do not depend on it, and on a loaded 2-core
@@ -402,7 +403,7 @@ static hang_result hang_cloth(int32_t cells, const double *coarse_disp, double *
     def.count_u = def.count_v = n;
     def.axis_v[0] = 0.0, def.axis_v[1] = 0.0, def.axis_v[2] = 1.0;
     def.material.stretch_stiffness = 10.0;
-    def.material.bend_stiffness = 0.0;
+    def.material.bend_stiffness = bend_stiffness;
     def.material.stretch_damping = 0.3;
     def.material.air_drag = 1.5;
     int32_t id = -1;
@@ -435,7 +436,7 @@ static hang_result hang_cloth(int32_t cells, const double *coarse_disp, double *
     double t0 = wall_seconds(), max_ke = 0.0;
     wc_energy e = {0};
     int f;
-    for (f = 1; f <= 500; ++f) {
+    for (f = 1; f * frame <= max_time + 0.5 * frame; ++f) {
         if (wc_world_advance(w, frame, 0) != WC_OK) {
             CHECK(0, "advance: %s", wc_world_last_error(w));
             break;
@@ -446,9 +447,10 @@ static hang_result hang_cloth(int32_t cells, const double *coarse_disp, double *
         if (f * frame >= min_time && e.kinetic < ke_settled) break;
     }
     r.seconds = wall_seconds() - t0;
+    if (f * frame > max_time + 0.5 * frame) --f;
     r.settle_time = f * frame;
     r.kinetic = e.kinetic;
-    CHECK(e.kinetic < ke_settled, "%d cells: not settled after %g s (KE %g J)", cells, f * frame,
+    CHECK(!require_settled || e.kinetic < ke_settled, "%d cells: not settled after %g s (KE %g J)", cells, f * frame,
           e.kinetic);
     if (!coarse_disp)
         CHECK(max_ke > 1e4 * ke_settled, "%d cells: never moved (max KE %g)", cells, max_ke);
@@ -458,6 +460,7 @@ static hang_result hang_cloth(int32_t cells, const double *coarse_disp, double *
     double mean = 0.0;
     for (int32_t i = 0; i < count; ++i) mean += rest[3 * i + 2] - x[3 * i + 2];
     r.mean_drop = mean / count;
+    r.bottom_width = x[3 * (n - 1)] - x[0]; /* bottom row, last minus first x */
     for (int32_t k = 0; k < 3 * count; ++k) x[k] -= rest[k];
     *out_disp = x;
     free(rest);
@@ -472,13 +475,13 @@ static void test_hanging_convergence(void)
     double *disp = NULL, *next = NULL;
     for (int level = 0; level < 3; ++level) {
         int32_t cells = 32 << level;
-        r[level] = hang_cloth(cells, disp, &next);
+        r[level] = hang_cloth(cells, 0.0, 10.0, 1, disp, &next);
         free(disp);
         disp = next;
         printf("hanging %3d cells: settled after %.2f s simulated (%d substeps, KE %.2e J, %.1f s "
-               "wall): bottom-centre drop %.9f m, mean drop %.9f m\n",
+               "wall): bottom-centre drop %.9f m, mean drop %.9f m, bottom width %.6f m\n",
                cells, r[level].settle_time, r[level].substeps, r[level].kinetic, r[level].seconds,
-               r[level].bottom_drop, r[level].mean_drop);
+               r[level].bottom_drop, r[level].mean_drop, r[level].bottom_width);
     }
     free(disp);
     double b1 = fabs(r[1].bottom_drop - r[0].bottom_drop), b2 = fabs(r[2].bottom_drop - r[1].bottom_drop);
@@ -499,6 +502,43 @@ static void test_hanging_convergence(void)
     double rho_g = 0.15 * 9.81;
     CHECK(r[2].bottom_drop > rho_g / (2.0 * 10.0) && r[2].bottom_drop < rho_g / (1.6 * 10.0),
           "sag %.6f outside [%.4f, %.4f]", r[2].bottom_drop, rho_g / 20.0, rho_g / 16.0);
+}
+
+/* The same sheet with the default bending stiffness (SPEC 1.3: the same
+ * material gives nearly the same drape at any resolution). Cheaper levels,
+ * 16 / 32 / 64 cells, each allowed 3 s of simulated time to settle. Measured
+ * when this test was written: the drop and the bottom width drift further at
+ * each refinement instead of converging (bottom width 0.933, 0.953, 0.985 m
+ * against 0.911 m without bending), because a bend link's resistance to
+ * in-plane compression, 12 R / l^2 at onset with R ~ B l, grows like 1/l
+ * per link and 1/l^2 per unit width. (The finer sheets also do not settle:
+ * the force's jump at onset keeps bend links chattering; the kinetic energy
+ * left is printed, not checked.) */
+static void test_hanging_default_bending(void)
+{
+    hang_result r[3];
+    double *disp = NULL, *next = NULL;
+    const double bend = wc_material_default().bend_stiffness;
+    for (int level = 0; level < 3; ++level) {
+        int32_t cells = 16 << level;
+        r[level] = hang_cloth(cells, bend, 3.0, 0, disp, &next);
+        free(disp);
+        disp = next;
+        printf("hanging, bend %g, %2d cells: %.2f s simulated (KE %.2e J, %.1f s wall): bottom-centre "
+               "drop %.9f m, mean drop %.9f m, bottom width %.6f m\n",
+               bend, cells, r[level].settle_time, r[level].kinetic, r[level].seconds,
+               r[level].bottom_drop, r[level].mean_drop, r[level].bottom_width);
+    }
+    free(disp);
+    double b1 = fabs(r[1].bottom_drop - r[0].bottom_drop), b2 = fabs(r[2].bottom_drop - r[1].bottom_drop);
+    double m1 = fabs(r[1].mean_drop - r[0].mean_drop), m2 = fabs(r[2].mean_drop - r[1].mean_drop);
+    double w1 = fabs(r[1].bottom_width - r[0].bottom_width), w2 = fabs(r[2].bottom_width - r[1].bottom_width);
+    printf("hanging, default bending: changes per doubling: bottom drop %.3e, %.3e; mean drop %.3e, "
+           "%.3e; bottom width %.3e, %.3e\n", b1, b2, m1, m2, w1, w2);
+    CHECK(b1 > 1.3 * b2, "default bending: bottom drop not converging: %.3e then %.3e", b1, b2);
+    CHECK(m1 > 1.3 * m2, "default bending: mean drop not converging: %.3e then %.3e", m1, m2);
+    /* (The width is printed only: even without bending it converges slowly,
+     * 1.03e-3 then 0.90e-3 m per doubling, from the free bottom corners.) */
 }
 
 /* ------------------------------------------------------------------------ */
@@ -606,6 +646,7 @@ int main(void)
     test_energy_conservation();
     test_advance_and_pins();
     test_hanging_convergence();
+    test_hanging_default_bending();
     printf("test_integration: %.1f s\n", wall_seconds() - t0);
     return test_report("test_integration");
 }
