@@ -136,7 +136,6 @@ static void test_null_world(void)
 static void test_null_arguments(void)
 {
     int32_t id = -1;
-    double xyz[3 * COUNT];
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     wc_mesh_cloth_def m = wc_mesh_cloth_def_default();
     expect(wc_world_add_grid_cloth(wa, NULL, &id), WC_ERROR_INVALID_ARGUMENT, "add_grid_cloth(def NULL)", "def", NULL);
@@ -157,7 +156,6 @@ static void test_null_arguments(void)
     expect(wc_cloth_get_view(wa, ca, NULL), WC_ERROR_INVALID_ARGUMENT, "get_view(NULL)", "NULL", NULL);
     expect(wc_cloth_get_energy(wa, ca, NULL), WC_ERROR_INVALID_ARGUMENT, "get_energy(NULL)", "NULL", NULL);
     expect(wc_cloth_get_triangles(wa, ca, NULL, 1000), WC_ERROR_INVALID_ARGUMENT, "get_triangles(NULL)", "NULL", NULL);
-    (void)xyz;
 }
 
 static void test_material(void)

@@ -191,8 +191,8 @@ static void test_force_limits_and_references(void)
     for (int s = 0; s < 4; ++s) {
         double l = scales[s][0], R = scales[s][1], unit = R / (l * l);
 
-        /* Full fold, d = 0: 4 pi^2 R / l^2. Only rounding of the few
-         * operations that scale Phi: 4 ulps. */
+        /* Full fold, d = 0: 4 pi^2 R / l^2. Only rounding of Phi and of the
+         * few operations that scale it: 8 ulps. */
         double f0 = wc_buckling_force(0.0, l, R);
         double fold = 4.0 * PI * PI * unit;
         printf("l=%g R=%g: F(0) / (R/l^2) = %.17g (4 pi^2 = %.17g)\n", l, R, f0 / unit,
