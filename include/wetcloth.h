@@ -181,6 +181,14 @@ typedef struct wc_material {
     /// Linear air drag, N*s/m^3: force -air_drag * A_i * v on each particle.
     /// [0, 1e4]. Default 0.02.
     double air_drag;
+    /// Collision thickness of the cloth, m, [0, 1]: particles keep at least
+    /// this much (plus the collider's thickness) from every surface, and at
+    /// least this much from other parts of the same cloth when it
+    /// self-collides. Default 0.005.
+    double thickness;
+    /// Coulomb friction coefficient against colliders and itself, [0, 10].
+    /// A contact uses sqrt(cloth friction * collider friction). Default 0.5.
+    double friction;
 } wc_material;
 
 /// The default material (plausible cotton).
@@ -207,6 +215,9 @@ typedef struct wc_mesh_cloth_def {
     int32_t face_size;
     /// Material.
     wc_material material;
+    /// 1 to keep the cloth from passing through itself, 0 (default) not to.
+    /// Off costs nothing.
+    int32_t self_collision;
 } wc_mesh_cloth_def;
 
 /// Default mesh cloth description (no geometry, default material).
@@ -234,6 +245,8 @@ typedef struct wc_grid_cloth_def {
     double axis_v[3];
     /// Material.
     wc_material material;
+    /// 1 to keep the cloth from passing through itself, 0 (default) not to.
+    int32_t self_collision;
 } wc_grid_cloth_def;
 
 /// Default grid: 32 x 32 particles, 1 m x 1 m in the plane z = 0.
@@ -254,7 +267,10 @@ typedef enum wc_link_kind {
     /// Tension-only links: mesh edges and both diagonals of every quad.
     WC_LINK_STRETCH = 0,
     /// Compression-only (buckling) links: (a, c) when (a, b) and (b, c) are
-    /// stretch links and the rest angle a-b-c is at least 150 degrees.
+    /// stretch links, the rest angle a-b-c is at least 150 degrees, and c is
+    /// the straightest continuation of a -> b through b and a that of c -> b.
+    /// On a regular grid: each particle to the one two steps away in each of
+    /// the 8 directions (the thesis' "skip one" links).
     WC_LINK_BEND = 1
 } wc_link_kind;
 
@@ -299,6 +315,15 @@ WC_API wc_status wc_cloth_get_velocities(const wc_world *world, int32_t cloth,
 WC_API wc_status wc_cloth_set_velocities(wc_world *world, int32_t cloth,
                                          const double *xyz, int32_t count);
 
+/// What a particle touched in the last step.
+typedef enum wc_contact_kind {
+    WC_CONTACT_NONE = 0,
+    /// A collider (mesh or convex shape).
+    WC_CONTACT_COLLIDER = 1,
+    /// Another part of a cloth.
+    WC_CONTACT_CLOTH = 2
+} wc_contact_kind;
+
 /// Read-only structure-of-arrays view of one cloth's particles. The pointers
 /// stay valid until the next call that changes the world (a step, advance,
 /// set_positions, ...).
@@ -310,6 +335,13 @@ typedef struct wc_cloth_view {
     const double *z;
     /// Masses, kg.
     const double *mass;
+    /// wc_contact_kind of each particle in the last step.
+    const uint8_t *contact;
+    /// Unit normal of the surface each particle touched in the last step,
+    /// pointing from the surface toward the particle; zero without contact.
+    const double *normal_x;
+    const double *normal_y;
+    const double *normal_z;
 } wc_cloth_view;
 
 /// Fills a view of a cloth's particles.
@@ -345,12 +377,147 @@ typedef struct wc_energy {
     /// 0.5 K (d - l)^2 over stretched links.
     double stretch;
     /// 0.5 R c^2 l over compressed bend links (c the arc curvature), the
-    /// potential whose gradient is the buckling force.
+    /// potential whose gradient is the buckling force (with its onset ramped
+    /// in over the first 0.1 % of compression, where the model jumps).
     double bend;
 } wc_energy;
 
 /// Computes a cloth's energy in its current state.
 WC_API wc_status wc_cloth_get_energy(const wc_world *world, int32_t cloth, wc_energy *out_energy);
+
+/// Copies each particle's contact kind (wc_contact_kind, count values) and
+/// surface normal (interleaved xyz, 3 * count values) from the last step.
+/// Either output may be NULL. count must equal the particle count.
+WC_API wc_status wc_cloth_get_contacts(const wc_world *world, int32_t cloth, uint8_t *out_kind,
+                                       double *out_normals_xyz, int32_t count);
+
+/* ------------------------------------------------------------------------ */
+/* Colliders                                                                 */
+/* ------------------------------------------------------------------------ */
+
+/// A triangle mesh collider: a thin surface (both sides repel) or the skin of
+/// a solid. Static unless wc_collider_set_vertices gives it new positions.
+typedef struct wc_mesh_collider_def {
+    /// Vertex positions, m, interleaved xyz, 3 * vertex_count finite values. Copied.
+    const double *vertices;
+    /// Number of vertices, 3 .. 2^26.
+    int32_t vertex_count;
+    /// Vertex indices, 3 per triangle, each in [0, vertex_count). Copied.
+    const int32_t *triangles;
+    /// Number of triangles, 1 .. 2^27.
+    int32_t triangle_count;
+    /// Thickness, m, [0, 1]: cloth keeps this much (plus its own thickness)
+    /// from the surface. Default 0.
+    double thickness;
+    /// Coulomb friction coefficient, [0, 10]. Default 0.5.
+    double friction;
+} wc_mesh_collider_def;
+
+/// Default mesh collider description (no geometry).
+WC_API wc_mesh_collider_def wc_mesh_collider_def_default(void);
+
+/// Adds a mesh collider; *out_collider receives its index. Degenerate
+/// (zero-area) triangles are accepted and ignored; they can come from
+/// animation.
+WC_API wc_status wc_world_add_mesh_collider(wc_world *world, const wc_mesh_collider_def *def,
+                                            int32_t *out_collider);
+
+/// Gives an animated mesh collider new vertex positions (m, interleaved xyz,
+/// finite; count = its vertex count). They are reached at the end of the
+/// next wc_world_step() or wc_world_advance(), moving linearly across its
+/// substeps; contacts use the relative motion, so fast colliders do not
+/// tunnel through cloth.
+WC_API wc_status wc_collider_set_vertices(wc_world *world, int32_t collider, const double *xyz,
+                                          int32_t count);
+
+/// Solid convex shapes. Their contacts come from libccd.
+typedef enum wc_shape {
+    /// Ball of `radius` around the position.
+    WC_SHAPE_SPHERE = 0,
+    /// Segment from -half_height to +half_height along the local z axis,
+    /// swept by a ball of `radius`.
+    WC_SHAPE_CAPSULE = 1,
+    /// Box with `half_extents` along the local axes.
+    WC_SHAPE_BOX = 2,
+    /// Convex hull of `points` (local coordinates).
+    WC_SHAPE_CONVEX_HULL = 3
+} wc_shape;
+
+/// A solid convex collider.
+typedef struct wc_convex_collider_def {
+    wc_shape shape;
+    /// Position of the local origin, m. Default (0, 0, 0).
+    double position[3];
+    /// Orientation as a unit quaternion (w, x, y, z) (normalised on input;
+    /// must not be zero). Default (1, 0, 0, 0).
+    double rotation[4];
+    /// Sphere and capsule radius, m, (0, 1e6]. Default 0.5.
+    double radius;
+    /// Capsule half length of its core segment, m, [0, 1e6]. Default 0.5.
+    double half_height;
+    /// Box half extents, m, each (0, 1e6]. Default (0.5, 0.5, 0.5).
+    double half_extents[3];
+    /// Hull points, local coordinates, m, interleaved xyz. Copied.
+    const double *points;
+    /// Number of hull points, 4 .. 65536; they must span a volume.
+    int32_t point_count;
+    /// Thickness, m, [0, 1]. Default 0.
+    double thickness;
+    /// Coulomb friction coefficient, [0, 10]. Default 0.5.
+    double friction;
+} wc_convex_collider_def;
+
+/// Default convex collider: unit-diameter sphere at the origin.
+WC_API wc_convex_collider_def wc_convex_collider_def_default(void);
+
+/// Adds a convex collider; *out_collider receives its index (colliders of
+/// both kinds share one index space).
+WC_API wc_status wc_world_add_convex_collider(wc_world *world, const wc_convex_collider_def *def,
+                                              int32_t *out_collider);
+
+/// Moves a convex collider: position (m) and unit quaternion (w, x, y, z),
+/// reached at the end of the next step or advance, interpolated across its
+/// substeps.
+WC_API wc_status wc_collider_set_transform(wc_world *world, int32_t collider,
+                                           const double position[3], const double rotation[4]);
+
+/// Number of colliders in the world.
+WC_API int32_t wc_world_collider_count(const wc_world *world);
+
+/* ------------------------------------------------------------------------ */
+/* Statistics and the intersection checker                                  */
+/* ------------------------------------------------------------------------ */
+
+/// What the last step (or, for wc_world_advance, its last substep) did.
+typedef struct wc_step_stats {
+    /// Particles in contact with a collider.
+    int32_t collider_contacts;
+    /// Particles in contact with cloth (self-collision).
+    int32_t cloth_contacts;
+    /// Particles a fail-safe had to put back where they were at the start of
+    /// the step, because no response left them free of intersection.
+    int32_t failsafe_particles;
+} wc_step_stats;
+
+/// Statistics of the last step.
+WC_API wc_step_stats wc_world_get_stats(const wc_world *world);
+
+/// Intersecting triangle pairs in the current state.
+typedef struct wc_intersection_counts {
+    /// Pairs of cloth triangles that share no vertex and intersect (within a
+    /// cloth, and between cloths).
+    int32_t cloth_cloth;
+    /// Pairs of a cloth triangle and a collider triangle that intersect, plus
+    /// cloth triangles that reach inside a convex collider.
+    int32_t cloth_collider;
+} wc_intersection_counts;
+
+/// Counts intersecting triangle pairs in the current state. Written
+/// independently of the collision solver (its own triangle-triangle test and
+/// its own broadphase), so tests and benchmarks can trust it to catch what
+/// the solver misses. Thickness is ignored: only true intersections count.
+WC_API wc_status wc_world_count_intersections(const wc_world *world,
+                                              wc_intersection_counts *out_counts);
 
 #ifdef __cplusplus
 }

@@ -64,20 +64,23 @@ double wc_inverse_sinc_gap(double gap)
     /* Halley's method on h(theta) = (1 - sinc theta) - gap:
      *   h'  = theta * q,    q = (sinc - cos) / theta^2
      *   h'' = sinc - 2 q
-     * Convergence is cubic: once a step is below 1e-5 of theta, the error
-     * left after it is far below rounding, so the loop stops there. From
-     * the initial guess that takes two passes. */
+     *   step = (h / h') / (1 - (h / h') h'' / (2 h'))
+     * written with the ratio h / h' first, since h and h' can both be tiny
+     * (gap = 1e-300 gives theta ~ 1e-150, and h * h' would underflow).
+     * Convergence is cubic, the error after a step about (step)^3: once a
+     * step is below 1e-7 of theta, what is left is far below rounding, so
+     * the loop stops there. From the initial guess that takes two passes. */
     for (int iter = 0; iter < 8; ++iter) {
         double gap_of, q;
         sinc_terms(theta, &gap_of, &q);
-        double h = gap_of - gap;
         double h1 = theta * q;
         double h2 = (1.0 - gap_of) - 2.0 * q;
-        double step = 2.0 * h * h1 / (2.0 * h1 * h1 - h * h2);
+        double ratio = (gap_of - gap) / h1;
+        double step = ratio / (1.0 - 0.5 * ratio * h2 / h1);
         double next = theta - step;
         if (next < 0.0) next = 0.5 * theta;
         if (next > WC_PI) next = 0.5 * (theta + WC_PI);
-        int done = fabs(next - theta) <= 1e-5 * next;
+        int done = fabs(next - theta) <= 1e-7 * next;
         theta = next;
         if (done) break;
     }
@@ -101,4 +104,23 @@ double wc_buckling_energy(double d, double l, double R)
     if (!(d < l)) return 0.0;
     double theta = wc_inverse_sinc_gap((l - d) / l);
     return 2.0 * R * theta * theta / l;
+}
+
+double wc_buckling_force_ramped(double d, double l, double R)
+{
+    if (!(d < l)) return 0.0;
+    double gap = (l - d) / l;
+    if (gap >= WC_BUCKLING_ONSET_RAMP) return R / (l * l) * wc_buckling_phi_of_gap(gap);
+    return R / (l * l) * wc_buckling_phi_of_gap(WC_BUCKLING_ONSET_RAMP) * (gap / WC_BUCKLING_ONSET_RAMP);
+}
+
+double wc_buckling_energy_ramped(double d, double l, double R)
+{
+    if (!(d < l)) return 0.0;
+    double gap = (l - d) / l, ramp = WC_BUCKLING_ONSET_RAMP;
+    /* the ramp's energy up to the given gap: F_end / 2 * gap^2 / ramp * l */
+    double f_end = R / (l * l) * wc_buckling_phi_of_gap(ramp);
+    if (gap < ramp) return 0.5 * f_end * gap * gap / ramp * l;
+    double ramp_energy = 0.5 * f_end * ramp * l;
+    return ramp_energy + wc_buckling_energy(d, l, R) - wc_buckling_energy((1.0 - ramp) * l, l, R);
 }

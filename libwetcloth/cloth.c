@@ -5,6 +5,7 @@
 
 #include "alloc.h"
 #include "buckling.h"
+#include "selfcollide.h"
 #include "status.h"
 
 void wc_cloth_destroy(wc_cloth *c)
@@ -13,12 +14,16 @@ void wc_cloth_destroy(wc_cloth *c)
     double *arrays[] = {c->x,  c->y,  c->z,  c->px,      c->py,      c->pz,      c->nx,
                         c->ny, c->nz, c->fx, c->fy,      c->fz,      c->vx,      c->vy,
                         c->vz, c->mass, c->inv_mass, c->stretch_k, c->stretch_c, c->bend_r,
-                        c->link_fx, c->link_fy, c->link_fz, c->pins.from, c->pins.to};
+                        c->link_fx, c->link_fy, c->link_fz, c->pins.from, c->pins.to,
+                        c->normal_x, c->normal_y, c->normal_z, c->qx, c->qy, c->qz};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
     wc_free(c->link_start);
     wc_free(c->link_list);
     wc_free(c->pin_slot);
     wc_free(c->pins.particle);
+    wc_free(c->contact);
+    wc_free(c->history_override);
+    wc_self_state_destroy(c->self);
     wc_topology_free(&c->topology);
     wc_free(c);
 }
@@ -50,7 +55,12 @@ static int alloc_particle_arrays(wc_cloth *c)
     c->link_start = wc_alloc_array(n + 1, sizeof *c->link_start);
     c->link_list = wc_alloc_array(2 * links, sizeof *c->link_list);
     c->pin_slot = wc_alloc_array(n, sizeof *c->pin_slot);
-    return ok && c->link_start && c->link_list && c->pin_slot;
+    ok &= alloc_doubles(&c->normal_x, n) & alloc_doubles(&c->normal_y, n) &
+          alloc_doubles(&c->normal_z, n) & alloc_doubles(&c->qx, n) & alloc_doubles(&c->qy, n) &
+          alloc_doubles(&c->qz, n);
+    c->contact = wc_alloc_array(n, sizeof *c->contact);
+    c->history_override = wc_alloc_array(n, sizeof *c->history_override);
+    return ok && c->link_start && c->link_list && c->pin_slot && c->contact && c->history_override;
 }
 
 /* Per-particle link lists in ascending link order: the order in which a
@@ -83,7 +93,7 @@ static void build_link_lists(wc_cloth *c)
 
 /* Gershgorin bound on the highest angular frequency of the linearised
  * system: omega^2 <= max_i sum_links k (1/m_i + 1/sqrt(m_i m_j)), with k the
- * stretch K or the buckling stiffness bound 12 pi^2 R / l^3. Damping and drag
+ * stretch K or the bound on the ramped buckling force's slope, 12007 R / l^3. Damping and drag
  * shorten the explicit stable step further: for a damped oscillator with
  * ratio z the limit becomes 2 (sqrt(1 + z^2) - z) / omega, and drag alone
  * needs dt < 2 m / c. */
@@ -104,7 +114,7 @@ static double estimate_stable_dt(const wc_cloth *c)
             } else {
                 int32_t f = e - st->count;
                 double l = bd->rest[f];
-                stiffness = WC_BUCKLING_STIFFNESS_BOUND * c->bend_r[f] / (l * l * l);
+                stiffness = WC_BUCKLING_STIFFNESS_BOUND_RAMPED * c->bend_r[f] / (l * l * l);
                 a = bd->a[f], b = bd->b[f];
             }
             int32_t j = a == i ? b : a;
@@ -150,7 +160,7 @@ static wc_status apply_material(wc_cloth *c, wc_message *msg)
 
 wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const int32_t *faces,
                           int32_t face_count, int32_t face_size, const wc_material *material,
-                          wc_message *msg)
+                          int self_collision, wc_message *msg)
 {
     *out = NULL;
     wc_cloth *c = wc_alloc_array(1, sizeof *c);
@@ -173,6 +183,15 @@ wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const in
         c->z[i] = xyz[3 * (size_t)i + 2];
     }
     build_link_lists(c);
+    if (self_collision) {
+        c->self = wc_self_state_create(c);
+        if (!c->self) {
+            wc_cloth_destroy(c);
+            return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY,
+                           "out of memory for the self-collision buffers of a cloth of %d vertices",
+                           (int)n);
+        }
+    }
     s = apply_material(c, msg);
     if (s) {
         wc_cloth_destroy(c);
@@ -182,12 +201,15 @@ wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const in
     return WC_OK;
 }
 
-void wc_cloth_commit(wc_cloth *c, double dt)
+void wc_cloth_commit(wc_cloth *c, double dt, int with_overrides)
 {
     double *t;
     t = c->px, c->px = c->x, c->x = c->nx, c->nx = t;
     t = c->py, c->py = c->y, c->y = c->ny, c->ny = t;
     t = c->pz, c->pz = c->z, c->z = c->nz, c->nz = t;
+    if (with_overrides)
+        for (int32_t i = 0; i < c->particle_count; ++i)
+            if (c->history_override[i]) c->px[i] = c->qx[i], c->py[i] = c->qy[i], c->pz[i] = c->qz[i];
     c->has_history = 1;
     c->dt_prev = dt;
 }

@@ -63,17 +63,32 @@ typedef struct wc_cloth {
 
     /// Stable step estimate, s (see wc_world_stable_dt).
     double stable_dt;
+
+    /* Collisions. */
+    /// wc_contact_kind of each particle in the last step.
+    uint8_t *contact;
+    /// Surface normal at each particle's contact (toward the particle).
+    double *normal_x, *normal_y, *normal_z;
+    /// Where a collision response changed a particle's velocity, the
+    /// previous position that encodes the new velocity: at commit, px gets
+    /// q instead of x for particles whose history_override is set.
+    double *qx, *qy, *qz;
+    uint8_t *history_override;
+    /// Self-collision buffers; NULL when self-collision is off.
+    struct wc_self_state *self;
 } wc_cloth;
 
 /// Creates a cloth from a validated description. On failure nothing leaks.
 wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t vertex_count,
                           const int32_t *faces, int32_t face_count, int32_t face_size,
-                          const wc_material *material, wc_message *msg);
+                          const wc_material *material, int self_collision, wc_message *msg);
 
 void wc_cloth_destroy(wc_cloth *cloth);
 
-/// Moves px/x/nx one step on after a successful step of length dt.
-void wc_cloth_commit(wc_cloth *cloth, double dt);
+/// Moves px/x/nx one step on after a successful step of length dt. With
+/// overrides, particles whose history_override is set get q as their
+/// previous position, which carries the velocity a collision gave them.
+void wc_cloth_commit(wc_cloth *cloth, double dt, int with_overrides);
 
 /// Velocity of particle i, m/s (see wc_cloth_get_velocities).
 void wc_cloth_velocity(const wc_cloth *cloth, int32_t i, double v[3]);

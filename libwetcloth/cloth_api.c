@@ -74,11 +74,15 @@ wc_status wc_world_add_mesh_cloth(wc_world *w, const wc_mesh_cloth_def *d, int32
     if (!d->vertices || !d->faces)
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "mesh_cloth_def.%s is NULL",
                        d->vertices ? "faces" : "vertices");
+    if (d->self_collision != 0 && d->self_collision != 1)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_cloth_def.self_collision must be 0 or 1 but is %d",
+                       (int)d->self_collision);
     wc_status s = wc_material_validate(&d->material, msg);
     if (s) return s;
     wc_cloth *c;
     s = wc_cloth_create(&c, d->vertices, d->vertex_count, d->faces, d->face_count, d->face_size,
-                        &d->material, msg);
+                        &d->material, d->self_collision, msg);
     if (s) return s;
     return append_cloth(w, c, out_cloth);
 }
@@ -112,6 +116,10 @@ static wc_status validate_grid(const wc_grid_cloth_def *d, wc_message *msg)
                        "grid_cloth_def.axis_u and axis_v must be perpendicular unit vectors but "
                        "have lengths %g and %g and dot product %g",
                        sqrt(lu), sqrt(lv), dot);
+    if (d->self_collision != 0 && d->self_collision != 1)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "grid_cloth_def.self_collision must be 0 or 1 but is %d",
+                       (int)d->self_collision);
     return wc_material_validate(&d->material, msg);
 }
 
@@ -148,7 +156,7 @@ wc_status wc_world_add_grid_cloth(wc_world *w, const wc_grid_cloth_def *d, int32
             f[3] = (j + 1) * nu + i;
         }
     wc_cloth *c;
-    s = wc_cloth_create(&c, xyz, n, faces, quads, 4, &d->material, &w->error);
+    s = wc_cloth_create(&c, xyz, n, faces, quads, 4, &d->material, d->self_collision, &w->error);
     wc_free(xyz);
     wc_free(faces);
     if (s) return s;
@@ -333,6 +341,10 @@ wc_status wc_cloth_get_view(const wc_world *w, int32_t cloth, wc_cloth_view *out
     out->y = c->y;
     out->z = c->z;
     out->mass = c->mass;
+    out->contact = c->contact;
+    out->normal_x = c->normal_x;
+    out->normal_y = c->normal_y;
+    out->normal_z = c->normal_z;
     return WC_OK;
 }
 
@@ -474,8 +486,26 @@ wc_status wc_cloth_get_energy(const wc_world *w, int32_t cloth, wc_energy *out)
         double d = sqrt((c->x[a] - c->x[b]) * (c->x[a] - c->x[b]) +
                         (c->y[a] - c->y[b]) * (c->y[a] - c->y[b]) +
                         (c->z[a] - c->z[b]) * (c->z[a] - c->z[b]));
-        e.bend += wc_buckling_energy(d, t->bend.rest[k], c->bend_r[k]);
+        e.bend += wc_buckling_energy_ramped(d, t->bend.rest[k], c->bend_r[k]);
     }
     *out = e;
+    return WC_OK;
+}
+
+wc_status wc_cloth_get_contacts(const wc_world *w, int32_t cloth, uint8_t *out_kind,
+                                double *out_normals, int32_t count)
+{
+    const void *any = out_kind ? (const void *)out_kind : (const void *)out_normals;
+    wc_cloth *c = cloth_with_count(w, cloth, any ? any : (const void *)w, count,
+                                   wc_cloth_particle_count(w, cloth), "wc_cloth_get_contacts");
+    if (!c) return lookup_status(w, cloth);
+    for (int32_t i = 0; i < count; ++i) {
+        if (out_kind) out_kind[i] = c->contact[i];
+        if (out_normals) {
+            out_normals[3 * (size_t)i] = c->normal_x[i];
+            out_normals[3 * (size_t)i + 1] = c->normal_y[i];
+            out_normals[3 * (size_t)i + 2] = c->normal_z[i];
+        }
+    }
     return WC_OK;
 }

@@ -14,6 +14,7 @@
 static void compute_velocities(wc_cloth *c, int threads)
 {
     int32_t n = c->particle_count;
+    (void)threads; /* unused when built without OpenMP */
     if (!c->has_history) {
         for (int32_t i = 0; i < n; ++i) c->vx[i] = c->px[i], c->vy[i] = c->py[i], c->vz[i] = c->pz[i];
         return;
@@ -31,6 +32,7 @@ static void compute_velocities(wc_cloth *c, int threads)
  * The dashpot acts along the link whether it is taut or slack. */
 static void stretch_link_forces(wc_cloth *c, int threads)
 {
+    (void)threads;
     const wc_link_set *s = &c->topology.stretch;
     const double *x = c->x, *y = c->y, *z = c->z;
     const double *k = c->stretch_k, *damp = c->stretch_c;
@@ -53,9 +55,11 @@ static void stretch_link_forces(wc_cloth *c, int threads)
 }
 
 /* Thesis eq. 2.2-2.3 (Choi & Ko): a compressed bend link pushes its ends
- * apart with (R / l^2) Phi(theta); see buckling.h. */
+ * apart with (R / l^2) Phi(theta), ramped in over the first 0.1 % of
+ * compression; see buckling.h. */
 static void bend_link_forces(wc_cloth *c, int threads)
 {
+    (void)threads;
     const wc_link_set *s = &c->topology.bend;
     const double *x = c->x, *y = c->y, *z = c->z, *r = c->bend_r;
     int32_t count = s->count, offset = c->topology.stretch.count;
@@ -66,7 +70,7 @@ static void bend_link_forces(wc_cloth *c, int threads)
         double d = sqrt(dx * dx + dy * dy + dz * dz);
         double l = s->rest[e];
         double scale = 0.0;
-        if (d < l && d > FOLDED_FRACTION * l) scale = wc_buckling_force(d, l, r[e]) / d;
+        if (d < l && d > FOLDED_FRACTION * l) scale = wc_buckling_force_ramped(d, l, r[e]) / d;
         c->link_fx[offset + e] = scale * dx;
         c->link_fy[offset + e] = scale * dy;
         c->link_fz[offset + e] = scale * dz;
@@ -75,6 +79,7 @@ static void bend_link_forces(wc_cloth *c, int threads)
 
 static void gather_particle_forces(wc_cloth *c, const double g[3], int threads)
 {
+    (void)threads;
     int32_t n = c->particle_count;
     const int32_t *start = c->link_start, *list = c->link_list;
     const double *area = c->topology.area;

@@ -13,13 +13,16 @@ static void pinned_position(const wc_cloth *c, int32_t slot, double fraction, do
 int32_t wc_integrate_verlet(wc_cloth *c, double dt, double pin_fraction, int threads)
 {
     int32_t n = c->particle_count;
+    (void)threads;
     int first = !c->has_history;
-    /* x(t+dt) = x + (x - x_prev) * dt/dt_prev + a dt^2: Verlet, with the
-     * history rescaled when the step length changes. The first step starts
-     * from the velocity v held in px: x + v dt + a dt^2 / 2, which is what
-     * makes free fall exact to rounding. */
+    /* x(t+dt) = x + (x - x_prev) dt/dt_prev + a dt (dt + dt_prev) / 2:
+     * Verlet for a step length that may change (with a constant step it is
+     * exactly x + (x - x_prev) + a dt^2, thesis eq. 2.4). The history is
+     * rescaled to the new step, and the acceleration acts over the mean of
+     * the two steps, which keeps constant acceleration exact. The first step
+     * starts from the velocity v held in px: x + v dt + a dt^2 / 2. */
     double ratio = first ? dt : dt / c->dt_prev;
-    double acc_scale = first ? 0.5 * dt * dt : dt * dt;
+    double acc_scale = first ? 0.5 * dt * dt : 0.5 * dt * (dt + c->dt_prev);
     int bad = 0;
 #pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN) \
     reduction(|| : bad)

@@ -12,6 +12,8 @@ wc_material wc_material_default(void)
     m.bend_stiffness = 1e-5;
     m.stretch_damping = 0.05;
     m.air_drag = 0.02;
+    m.thickness = 0.005;
+    m.friction = 0.5;
     return m;
 }
 
@@ -33,5 +35,7 @@ wc_status wc_material_validate(const wc_material *m, wc_message *msg)
     if ((s = check_range(msg, "bend_stiffness", m->bend_stiffness, 0.0, 1e3, 0))) return s;
     if ((s = check_range(msg, "stretch_damping", m->stretch_damping, 0.0, 1.0, 0))) return s;
     if ((s = check_range(msg, "air_drag", m->air_drag, 0.0, 1e4, 0))) return s;
+    if ((s = check_range(msg, "thickness", m->thickness, 0.0, 1.0, 0))) return s;
+    if ((s = check_range(msg, "friction", m->friction, 0.0, 10.0, 0))) return s;
     return WC_OK;
 }

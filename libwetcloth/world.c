@@ -4,9 +4,11 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "collide.h"
 #include "forces.h"
 #include "integrate.h"
 #include "parallel.h"
+#include "selfcollide.h"
 #include "status.h"
 
 int32_t wc_version(void) { return WC_VERSION; }
@@ -75,7 +77,9 @@ void wc_world_destroy(wc_world *w)
 {
     if (!w) return;
     for (int32_t i = 0; i < w->cloth_count; ++i) wc_cloth_destroy(w->cloths[i]);
+    for (int32_t i = 0; i < w->collider_count; ++i) wc_collider_destroy(w->colliders[i]);
     wc_free(w->cloths);
+    wc_free(w->colliders);
     wc_free(w);
 }
 
@@ -95,39 +99,91 @@ wc_cloth *wc_world_find_cloth(const wc_world *w, int32_t cloth, const char *call
 /* Stepping                                                                  */
 /* ------------------------------------------------------------------------ */
 
+static int any_self_collision(const wc_world *w)
+{
+    for (int32_t c = 0; c < w->cloth_count; ++c)
+        if (w->cloths[c]->self) return 1;
+    return 0;
+}
+
+static wc_status non_finite_error(wc_world *w, double dt, int32_t cloth, int32_t particle,
+                                  const char *phase)
+{
+    return wc_fail(&w->error, WC_ERROR_NON_FINITE,
+                   "step of %g s would move particle %d of cloth %d to a non-finite position "
+                   "(in %s); the stable step is about %g s. The world keeps its last good state",
+                   dt, (int)particle, (int)cloth, phase, w->cloths[cloth]->stable_dt);
+}
+
+/* Colliders move to where they are at the end of this step; each contact
+ * then answers to the relative motion. `share` is the part of what is left
+ * of the advance that this step covers. */
+static wc_status collide(wc_world *w, double dt, double share, int threads)
+{
+    for (int32_t k = 0; k < w->collider_count; ++k)
+        if (wc_collider_begin_step(w->colliders[k], share))
+            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                           "out of memory indexing collider %d; the world keeps its last good state",
+                           (int)k);
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
+        wc_cloth *cl = w->cloths[c];
+        memset(cl->contact, 0, (size_t)cl->particle_count);
+        memset(cl->history_override, 0, (size_t)cl->particle_count);
+        if (w->collider_count)
+            wc_collide_cloth(cl, w->colliders, w->collider_count, dt, threads, &w->stats);
+        if (cl->self && wc_self_collide(cl, dt, threads, &w->stats))
+            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                           "out of memory in the self-collision of cloth %d; the world keeps its "
+                           "last good state", (int)c);
+        long bad = -1;
+        for (int axis = 0; axis < 3 && bad < 0; ++axis) {
+            const double *v = axis == 0 ? cl->nx : axis == 1 ? cl->ny : cl->nz;
+            bad = wc_first_non_finite(v, cl->particle_count);
+        }
+        if (bad >= 0) return non_finite_error(w, dt, c, (int32_t)bad, "collision response");
+    }
+    return WC_OK;
+}
+
 /* One step of the whole world, top to bottom: forces, integration,
- * (collisions and the wet response come in here), commit. Nothing is
- * committed unless every cloth's new state is finite. */
-static wc_status world_step(wc_world *w, double dt, double pin_fraction)
+ * collisions (with colliders, then each cloth with itself), then the
+ * commit. (The wet response joins after the collisions.) Nothing is
+ * committed unless every cloth's new state is finite, so a failed step
+ * leaves the world exactly as it was. */
+static wc_status world_step(wc_world *w, double dt, double share, double pin_fraction)
 {
     int threads = wc_thread_count(w->def.thread_count);
+    memset(&w->stats, 0, sizeof w->stats);
     for (int32_t c = 0; c < w->cloth_count; ++c)
         wc_forces_compute(w->cloths[c], w->def.gravity, threads);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         int32_t bad = wc_integrate_verlet(w->cloths[c], dt, pin_fraction, threads);
-        if (bad >= 0)
-            return wc_fail(&w->error, WC_ERROR_NON_FINITE,
-                           "step of %g s would move particle %d of cloth %d to a non-finite "
-                           "position; the stable step is about %g s. The world keeps its last "
-                           "good state", dt, (int)bad, (int)c, w->cloths[c]->stable_dt);
+        if (bad >= 0) return non_finite_error(w, dt, c, bad, "integration");
     }
-    for (int32_t c = 0; c < w->cloth_count; ++c) wc_cloth_commit(w->cloths[c], dt);
+    int colliding = w->collider_count > 0 || any_self_collision(w);
+    if (colliding) {
+        wc_status s = collide(w, dt, share, threads);
+        if (s) return s;
+    }
+    for (int32_t c = 0; c < w->cloth_count; ++c) wc_cloth_commit(w->cloths[c], dt, colliding);
+    for (int32_t k = 0; k < w->collider_count; ++k) wc_collider_end_step(w->colliders[k]);
     w->time += dt;
     return WC_OK;
 }
 
-/* After an advance (complete or not) the pins start the next one from where
- * they are. */
+/* After an advance, pins start the next one from where they are. A
+ * complete advance has brought them to their targets; after a failed one
+ * they keep their targets, so the next advance still takes them there. */
 static void settle_pins(wc_world *w)
 {
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_cloth *cl = w->cloths[c];
         for (int32_t p = 0; p < cl->pins.count; ++p) {
             int32_t i = cl->pins.particle[p];
-            double *from = cl->pins.from + 3 * (size_t)p, *to = cl->pins.to + 3 * (size_t)p;
-            from[0] = to[0] = cl->x[i];
-            from[1] = to[1] = cl->y[i];
-            from[2] = to[2] = cl->z[i];
+            double *from = cl->pins.from + 3 * (size_t)p;
+            from[0] = cl->x[i];
+            from[1] = cl->y[i];
+            from[2] = cl->z[i];
         }
     }
 }
@@ -145,7 +201,7 @@ wc_status wc_world_step(wc_world *w, double dt)
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
     wc_status s = check_step_length(w, "wc_world_step: dt", dt);
     if (s) return s;
-    s = world_step(w, dt, 1.0);
+    s = world_step(w, dt, 1.0, 1.0);
     settle_pins(w);
     return s;
 }
@@ -179,7 +235,7 @@ wc_status wc_world_advance(wc_world *w, double frame_dt, int32_t substeps)
     }
     double dt = frame_dt / substeps;
     for (int32_t k = 0; k < substeps && !s; ++k)
-        s = world_step(w, dt, (double)(k + 1) / substeps);
+        s = world_step(w, dt, 1.0 / (substeps - k), (double)(k + 1) / substeps);
     settle_pins(w);
     w->last_substeps = substeps;
     return s;
@@ -190,3 +246,9 @@ int32_t wc_world_last_substeps(const wc_world *w) { return w ? w->last_substeps 
 double wc_world_time(const wc_world *w) { return w ? w->time : 0.0; }
 
 int32_t wc_world_cloth_count(const wc_world *w) { return w ? w->cloth_count : 0; }
+
+wc_step_stats wc_world_get_stats(const wc_world *w)
+{
+    wc_step_stats none = {0, 0, 0};
+    return w ? w->stats : none;
+}

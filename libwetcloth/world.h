@@ -2,6 +2,7 @@
 #define WC_WORLD_H
 
 #include "cloth.h"
+#include "collider.h"
 #include "wetcloth.h"
 
 struct wc_world {
@@ -9,8 +10,12 @@ struct wc_world {
     wc_cloth **cloths;
     int32_t cloth_count;
     int32_t cloth_capacity;
+    wc_collider **colliders;
+    int32_t collider_count;
+    int32_t collider_capacity;
     double time;
     int32_t last_substeps;
+    wc_step_stats stats;
     /// Message of the last failed call. Calls that take a const world still
     /// report here: the world itself is never const-defined (it comes from
     /// wc_world_create), so writing through a cast pointer is well defined.

@@ -392,6 +392,46 @@ static void test_force_matches_exact_path(void)
     CHECK(bad == 0, "%d points differ", bad);
 }
 
+/* The force as the simulation applies it (WC_BUCKLING_ONSET_RAMP): zero at
+ * and beyond the rest length; linear in the compression up to a gap of
+ * 1e-3, where it meets the exact force continuously; exactly the Choi-Ko
+ * force beyond; minus the gradient of wc_buckling_energy_ramped; its slope
+ * within WC_BUCKLING_STIFFNESS_BOUND_RAMPED R / l^3. */
+static void test_ramped_force(void)
+{
+    const double l = 0.04, R = 3e-7, ramp = WC_BUCKLING_ONSET_RAMP;
+    CHECK(wc_buckling_force_ramped(l, l, R) == 0.0 && wc_buckling_force_ramped(1.1 * l, l, R) == 0.0,
+          "ramped force not zero at or past the rest length");
+    double at = wc_buckling_force_ramped((1.0 - ramp) * l, l, R);
+    double exact = wc_buckling_force((1.0 - ramp) * l, l, R);
+    CHECK(fabs(at - exact) <= 1e-12 * exact, "ramp end %.17g, exact %.17g", at, exact);
+    double half = wc_buckling_force_ramped((1.0 - 0.5 * ramp) * l, l, R);
+    CHECK(fabs(half - 0.5 * at) <= 1e-9 * at, "ramp not linear: half-way %.17g, end %.17g", half, at);
+    double worst_exact = 0.0, worst_gradient = 0.0, worst_slope = 0.0;
+    for (int k = 1; k < 20000; ++k) {
+        double d = l * (1.0 - k / 20000.0), h = 1e-7 * l;
+        double f = wc_buckling_force_ramped(d, l, R);
+        if ((l - d) / l >= ramp)
+            worst_exact = fmax(worst_exact, fabs(f - wc_buckling_force(d, l, R)) / f);
+        /* (the difference may not straddle the ramp's corner, where the
+         * force's slope changes: there it is off by ~h times that change) */
+        if (d - h > 0.0 && d + h < l && fabs((l - d) / l - ramp) > 2e-7) {
+            double grad = (wc_buckling_energy_ramped(d - h, l, R) - wc_buckling_energy_ramped(d + h, l, R)) / (2 * h);
+            worst_gradient = fmax(worst_gradient, fabs(grad - f) / f);
+            double slope = fabs(wc_buckling_force_ramped(d - h, l, R) - wc_buckling_force_ramped(d + h, l, R)) / (2 * h);
+            worst_slope = fmax(worst_slope, slope * l * l * l / R);
+        }
+    }
+    printf("ramped force: past the ramp within %.2e of exact; -dU/dd within %.2e; largest slope "
+           "%.1f R/l^3 (bound %.1f)\n", worst_exact, worst_gradient, worst_slope,
+           WC_BUCKLING_STIFFNESS_BOUND_RAMPED);
+    CHECK(worst_exact == 0.0, "ramped force differs from the exact one past the ramp by %g", worst_exact);
+    /* Central differences of an energy ~1e-10 J with h = 1e-7 l: rounding
+     * (~1e-16 J / 8e-9 m) and the h^2 term keep the match near 1e-6. */
+    CHECK(worst_gradient < 1e-5, "ramped force is not minus the energy's gradient: %g", worst_gradient);
+    CHECK(worst_slope <= WC_BUCKLING_STIFFNESS_BOUND_RAMPED, "slope %g above the bound", worst_slope);
+}
+
 int main(void)
 {
     test_inverse_sinc_references();
@@ -400,5 +440,6 @@ int main(void)
     test_force_matches_exact_path();
     test_force_sweep();
     test_force_is_energy_gradient();
+    test_ramped_force();
     return test_report("test_buckling");
 }

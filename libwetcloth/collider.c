@@ -1,0 +1,229 @@
+/* Collider storage and the public entry points that add and move colliders.
+ * Every entry point validates all of its input before changing anything. */
+#include "collider.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "convex.h"
+#include "status.h"
+#include "world.h"
+
+#define MAX_VERTICES (1 << 26)
+#define MAX_TRIANGLES (1 << 27)
+
+wc_mesh_collider_def wc_mesh_collider_def_default(void)
+{
+    wc_mesh_collider_def d;
+    memset(&d, 0, sizeof d);
+    d.friction = 0.5;
+    return d;
+}
+
+wc_convex_collider_def wc_convex_collider_def_default(void)
+{
+    wc_convex_collider_def d;
+    memset(&d, 0, sizeof d);
+    d.shape = WC_SHAPE_SPHERE;
+    d.rotation[0] = 1.0;
+    d.radius = 0.5;
+    d.half_height = 0.5;
+    d.half_extents[0] = d.half_extents[1] = d.half_extents[2] = 0.5;
+    d.friction = 0.5;
+    return d;
+}
+
+void wc_collider_destroy(wc_collider *c)
+{
+    if (!c) return;
+    wc_free(c->triangles);
+    wc_free(c->current);
+    wc_free(c->target);
+    wc_free(c->next);
+    wc_free(c->boxes);
+    wc_free(c->normal_current);
+    wc_free(c->normal_next);
+    wc_grid_free(&c->grid);
+    wc_convex_shape_free(&c->convex);
+    wc_free(c);
+}
+
+static wc_status append_collider(wc_world *w, wc_collider *c, int32_t *out)
+{
+    if (w->collider_count == w->collider_capacity) {
+        int32_t capacity = w->collider_capacity ? 2 * w->collider_capacity : 4;
+        wc_collider **grown = wc_alloc_array((size_t)capacity, sizeof *grown);
+        if (!grown) {
+            wc_collider_destroy(c);
+            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
+        }
+        if (w->collider_count)
+            memcpy(grown, w->colliders, (size_t)w->collider_count * sizeof *grown);
+        wc_free(w->colliders);
+        w->colliders = grown;
+        w->collider_capacity = capacity;
+    }
+    w->colliders[w->collider_count] = c;
+    *out = w->collider_count++;
+    return WC_OK;
+}
+
+static wc_status check_surface(wc_message *msg, const char *def, double thickness, double friction)
+{
+    if (!(isfinite(thickness) && thickness >= 0.0 && thickness <= 1.0))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s.thickness must be in [0, 1] m but is %g",
+                       def, thickness);
+    if (!(isfinite(friction) && friction >= 0.0 && friction <= 10.0))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s.friction must be in [0, 10] but is %g",
+                       def, friction);
+    return WC_OK;
+}
+
+static wc_status validate_mesh(const wc_mesh_collider_def *d, wc_message *msg)
+{
+    if (d->vertex_count < 3 || d->vertex_count > MAX_VERTICES)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_collider_def.vertex_count must be in [3, %d] but is %d", MAX_VERTICES,
+                       (int)d->vertex_count);
+    if (d->triangle_count < 1 || d->triangle_count > MAX_TRIANGLES)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_collider_def.triangle_count must be in [1, %d] but is %d",
+                       MAX_TRIANGLES, (int)d->triangle_count);
+    if (!d->vertices || !d->triangles)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "mesh_collider_def.%s is NULL",
+                       d->vertices ? "triangles" : "vertices");
+    long bad = wc_first_non_finite(d->vertices, 3L * d->vertex_count);
+    if (bad >= 0)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_collider_def.vertices: vertex %ld has a non-finite %c (%g)", bad / 3,
+                       "xyz"[bad % 3], d->vertices[bad]);
+    for (int64_t k = 0; k < 3 * (int64_t)d->triangle_count; ++k)
+        if (d->triangles[k] < 0 || d->triangles[k] >= d->vertex_count)
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                           "collider triangle %lld uses vertex %d, but the collider has %d vertices",
+                           (long long)(k / 3), (int)d->triangles[k], (int)d->vertex_count);
+    return check_surface(msg, "mesh_collider_def", d->thickness, d->friction);
+}
+
+wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d, int32_t *out)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    if (!d || !out)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_mesh_collider: %s is NULL",
+                       d ? "out_collider" : "def");
+    wc_status s = validate_mesh(d, &w->error);
+    if (s) return s;
+    wc_collider *c = wc_alloc_array(1, sizeof *c);
+    size_t nv = 3 * (size_t)d->vertex_count, nt = (size_t)d->triangle_count;
+    if (c) {
+        c->is_mesh = 1;
+        c->thickness = d->thickness;
+        c->friction = d->friction;
+        c->vertex_count = d->vertex_count;
+        c->triangle_count = d->triangle_count;
+        wc_grid_init(&c->grid);
+        c->triangles = wc_alloc_array(3 * nt, sizeof *c->triangles);
+        c->current = wc_alloc_array(nv, sizeof *c->current);
+        c->target = wc_alloc_array(nv, sizeof *c->target);
+        c->next = wc_alloc_array(nv, sizeof *c->next);
+        c->boxes = wc_alloc_array(6 * nt, sizeof *c->boxes);
+        c->normal_current = wc_alloc_array(3 * nt, sizeof *c->normal_current);
+        c->normal_next = wc_alloc_array(3 * nt, sizeof *c->normal_next);
+    }
+    if (!c || !c->triangles || !c->current || !c->target || !c->next || !c->boxes ||
+        !c->normal_current || !c->normal_next) {
+        wc_collider_destroy(c);
+        return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
+    }
+    memcpy(c->triangles, d->triangles, 3 * nt * sizeof *c->triangles);
+    memcpy(c->current, d->vertices, nv * sizeof *c->current);
+    memcpy(c->target, d->vertices, nv * sizeof *c->target);
+    memcpy(c->next, d->vertices, nv * sizeof *c->next);
+    return append_collider(w, c, out);
+}
+
+wc_status wc_world_add_convex_collider(wc_world *w, const wc_convex_collider_def *d, int32_t *out)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    if (!d || !out)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_world_add_convex_collider: %s is NULL", d ? "out_collider" : "def");
+    wc_collider *c = wc_alloc_array(1, sizeof *c);
+    if (!c) return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
+    wc_grid_init(&c->grid);
+    wc_status s = wc_convex_shape_init(&c->convex, &c->pose_current, d, &w->error);
+    if (s) {
+        wc_collider_destroy(c);
+        return s;
+    }
+    c->thickness = d->thickness;
+    c->friction = d->friction;
+    c->pose_target = c->pose_next = c->pose_current;
+    return append_collider(w, c, out);
+}
+
+static wc_collider *find_collider(wc_world *w, int32_t collider, const char *caller)
+{
+    if (collider >= 0 && collider < w->collider_count) return w->colliders[collider];
+    wc_fail(&w->error, WC_ERROR_NOT_FOUND, "%s: collider %d does not exist (the world has %d)",
+            caller, (int)collider, (int)w->collider_count);
+    return NULL;
+}
+
+wc_status wc_collider_set_vertices(wc_world *w, int32_t collider, const double *xyz, int32_t count)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    wc_collider *c = find_collider(w, collider, "wc_collider_set_vertices");
+    if (!c) return WC_ERROR_NOT_FOUND;
+    if (!c->is_mesh)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_collider_set_vertices: collider %d is convex; use wc_collider_set_transform",
+                       (int)collider);
+    if (!xyz || count != c->vertex_count)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_collider_set_vertices: %s for collider %d (it has %d vertices, count is %d)",
+                       xyz ? "count mismatch" : "xyz is NULL", (int)collider, (int)c->vertex_count,
+                       (int)count);
+    long bad = wc_first_non_finite(xyz, 3L * count);
+    if (bad >= 0)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_collider_set_vertices: vertex %ld has a non-finite %c (%g)", bad / 3,
+                       "xyz"[bad % 3], xyz[bad]);
+    memcpy(c->target, xyz, 3 * (size_t)count * sizeof *xyz);
+    c->moving = memcmp(c->target, c->current, 3 * (size_t)count * sizeof *xyz) != 0;
+    return WC_OK;
+}
+
+wc_status wc_collider_set_transform(wc_world *w, int32_t collider, const double position[3],
+                                    const double rotation[4])
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    wc_collider *c = find_collider(w, collider, "wc_collider_set_transform");
+    if (!c) return WC_ERROR_NOT_FOUND;
+    if (c->is_mesh)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_collider_set_transform: collider %d is a mesh; use wc_collider_set_vertices",
+                       (int)collider);
+    if (!position || !rotation)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_collider_set_transform: %s is NULL",
+                       position ? "rotation" : "position");
+    double norm = 0.0;
+    for (int k = 0; k < 4; ++k) norm += rotation[k] * rotation[k];
+    norm = sqrt(norm);
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(position[k]))
+            return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                           "wc_collider_set_transform: position[%d] must be finite but is %g", k,
+                           position[k]);
+    if (!(isfinite(norm) && norm > 1e-12))
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_collider_set_transform: rotation must be a finite non-zero quaternion "
+                       "(w, x, y, z) but has norm %g", norm);
+    for (int k = 0; k < 3; ++k) c->pose_target.position[k] = position[k];
+    for (int k = 0; k < 4; ++k) c->pose_target.rotation[k] = rotation[k] / norm;
+    c->moving = memcmp(&c->pose_target, &c->pose_current, sizeof c->pose_target) != 0;
+    return WC_OK;
+}
+
+int32_t wc_world_collider_count(const wc_world *w) { return w ? w->collider_count : 0; }

@@ -1,0 +1,180 @@
+#include "grid.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "alloc.h"
+
+/* An item spanning more cells than this along the three axes together is
+ * kept in the `large` list instead of being written into every cell. */
+#define MAX_CELLS_PER_ITEM 64
+/* A query spanning more cells than this scans all items instead. */
+#define MAX_CELLS_PER_QUERY 4096
+
+void wc_grid_init(wc_grid *g) { memset(g, 0, sizeof *g); }
+
+void wc_grid_free(wc_grid *g)
+{
+    wc_free(g->start);
+    wc_free(g->items);
+    wc_free(g->large);
+    wc_grid_init(g);
+}
+
+int wc_boxes_overlap(const double a[6], const double b[6])
+{
+    return a[0] <= b[3] && b[0] <= a[3] && a[1] <= b[4] && b[1] <= a[4] && a[2] <= b[5] &&
+           b[2] <= a[5];
+}
+
+/* Cell coordinate of a value; clamped so huge coordinates cannot overflow. */
+static int32_t cell_of(double value, double inv_cell)
+{
+    double c = floor(value * inv_cell);
+    if (c < -1e9) c = -1e9;
+    if (c > 1e9) c = 1e9;
+    return (int32_t)c;
+}
+
+static uint32_t bucket_of(const wc_grid *g, int32_t ix, int32_t iy, int32_t iz)
+{
+    uint32_t h = ((uint32_t)ix * 73856093u) ^ ((uint32_t)iy * 19349663u) ^ ((uint32_t)iz * 83492791u);
+    return h & g->bucket_mask;
+}
+
+static void cell_range(const double box[6], double inv_cell, int32_t lo[3], int32_t hi[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = cell_of(box[k], inv_cell);
+        hi[k] = cell_of(box[k + 3], inv_cell);
+    }
+}
+
+static int64_t cells_in(const int32_t lo[3], const int32_t hi[3])
+{
+    return ((int64_t)hi[0] - lo[0] + 1) * ((int64_t)hi[1] - lo[1] + 1) * ((int64_t)hi[2] - lo[2] + 1);
+}
+
+/* Visits every cell of an item's range: pass 0 counts, pass 1 writes. */
+static void insert_item(wc_grid *g, int32_t item, const int32_t lo[3], const int32_t hi[3],
+                        int32_t *fill, int pass)
+{
+    for (int32_t z = lo[2]; z <= hi[2]; ++z)
+        for (int32_t y = lo[1]; y <= hi[1]; ++y)
+            for (int32_t x = lo[0]; x <= hi[0]; ++x) {
+                uint32_t b = bucket_of(g, x, y, z);
+                if (pass == 0) {
+                    g->start[b + 1]++;
+                } else {
+                    int32_t at = g->start[b] + fill[b];
+                    /* two cells of one item may share a bucket: store it once */
+                    if (fill[b] > 0 && g->items[at - 1] == item) continue;
+                    g->items[at] = item;
+                    fill[b]++;
+                }
+            }
+}
+
+wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double cell_size)
+{
+    g->boxes = boxes;
+    g->item_count = count;
+    g->cell_size = cell_size;
+    double inv = 1.0 / cell_size;
+    int64_t buckets = 64;
+    while (buckets < 2 * (int64_t)count) buckets *= 2;
+    if (buckets > g->table_capacity) {
+        wc_free(g->start);
+        g->start = wc_alloc_array((size_t)buckets + 1, sizeof *g->start);
+        g->table_capacity = g->start ? buckets : 0;
+        if (!g->start) return WC_ERROR_OUT_OF_MEMORY;
+    }
+    g->bucket_mask = (uint32_t)(buckets - 1);
+    memset(g->start, 0, ((size_t)buckets + 1) * sizeof *g->start);
+    int64_t entries = 0, large = 0;
+    for (int32_t i = 0; i < count; ++i) {
+        int32_t lo[3], hi[3];
+        cell_range(boxes + 6 * (size_t)i, inv, lo, hi);
+        int64_t cells = cells_in(lo, hi);
+        if (cells > MAX_CELLS_PER_ITEM) {
+            ++large;
+            continue;
+        }
+        entries += cells;
+        insert_item(g, i, lo, hi, NULL, 0);
+    }
+    if (entries > g->entry_capacity || large > 0) {
+        if (entries > g->entry_capacity) {
+            wc_free(g->items);
+            g->items = wc_alloc_array((size_t)entries, sizeof *g->items);
+            g->entry_capacity = g->items ? entries : 0;
+        }
+        wc_free(g->large);
+        g->large = large ? wc_alloc_array((size_t)large, sizeof *g->large) : NULL;
+        if (!g->items || (large && !g->large)) return WC_ERROR_OUT_OF_MEMORY;
+    }
+    int32_t *fill = wc_alloc_array((size_t)buckets, sizeof *fill);
+    if (!fill) return WC_ERROR_OUT_OF_MEMORY;
+    for (int64_t b = 0; b < buckets; ++b) g->start[b + 1] += g->start[b];
+    g->large_count = 0;
+    for (int32_t i = 0; i < count; ++i) {
+        int32_t lo[3], hi[3];
+        cell_range(boxes + 6 * (size_t)i, inv, lo, hi);
+        if (cells_in(lo, hi) > MAX_CELLS_PER_ITEM) g->large[g->large_count++] = i;
+        else insert_item(g, i, lo, hi, fill, 1);
+    }
+    /* Duplicates skipped in pass 1 leave gaps at bucket ends; close them so
+     * start[] describes the filled entries exactly. */
+    int32_t write = 0;
+    for (int64_t b = 0; b < (int64_t)buckets; ++b) {
+        int32_t begin = g->start[b];
+        g->start[b] = write;
+        for (int32_t k = 0; k < fill[b]; ++k) g->items[write++] = g->items[begin + k];
+    }
+    g->start[buckets] = write;
+    wc_free(fill);
+    return WC_OK;
+}
+
+/* Keeps out[0 .. n) sorted and unique; n may pass capacity (then only counted). */
+static int32_t insert_sorted(int32_t *out, int32_t n, int32_t capacity, int32_t item)
+{
+    int32_t stored = n < capacity ? n : capacity;
+    int32_t lo = 0, hi = stored;
+    while (lo < hi) {
+        int32_t mid = (lo + hi) / 2;
+        if (out[mid] < item) lo = mid + 1;
+        else hi = mid;
+    }
+    if (lo < stored && out[lo] == item) return n;
+    if (n >= capacity) return n + 1; /* overflowing: count only (may over-count duplicates) */
+    memmove(out + lo + 1, out + lo, (size_t)(stored - lo) * sizeof *out);
+    out[lo] = item;
+    return n + 1;
+}
+
+int32_t wc_grid_query(const wc_grid *g, const double box[6], int32_t *out, int32_t capacity)
+{
+    int32_t n = 0;
+    for (int32_t k = 0; k < g->large_count; ++k)
+        if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)g->large[k]))
+            n = insert_sorted(out, n, capacity, g->large[k]);
+    int32_t lo[3], hi[3];
+    cell_range(box, 1.0 / g->cell_size, lo, hi);
+    if (cells_in(lo, hi) > MAX_CELLS_PER_QUERY) {
+        for (int32_t i = 0; i < g->item_count; ++i)
+            if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)i)) n = insert_sorted(out, n, capacity, i);
+        return n;
+    }
+    for (int32_t z = lo[2]; z <= hi[2]; ++z)
+        for (int32_t y = lo[1]; y <= hi[1]; ++y)
+            for (int32_t x = lo[0]; x <= hi[0]; ++x) {
+                uint32_t b = bucket_of(g, x, y, z);
+                for (int32_t k = g->start[b]; k < g->start[b + 1]; ++k) {
+                    int32_t item = g->items[k];
+                    if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)item))
+                        n = insert_sorted(out, n, capacity, item);
+                }
+            }
+    return n;
+}

@@ -1,0 +1,38 @@
+/* Geometric primitives for collision: closest points and continuous
+ * (swept) tests of a point against a triangle and an edge against an edge,
+ * both moving linearly over a step. Plain double[3] vectors. */
+#ifndef WC_PRIMITIVES_H
+#define WC_PRIMITIVES_H
+
+/// Closest point of triangle (a, b, c) to p. Returns the squared distance and
+/// writes the barycentric coordinates (weights of a, b, c) of the closest point.
+double wc_point_triangle_closest(const double p[3], const double a[3], const double b[3],
+                                 const double c[3], double bary[3]);
+
+/// Closest points of segments p0-p1 and q0-q1. Returns the squared distance
+/// and writes the parameters s (along p) and t (along q), both in [0, 1].
+double wc_segment_segment_closest(const double p0[3], const double p1[3], const double q0[3],
+                                  const double q1[3], double *s, double *t);
+
+/// Earliest time t in [0, 1] at which point p and triangle (a, b, c), each
+/// moving linearly from its "0" to its "1" position, are coplanar with the
+/// point within `tolerance` (m) of the triangle. Solves the coplanarity cubic
+/// (Provot 1997; Bridson et al. 2002). Returns 1 and writes t and the
+/// barycentric coordinates of the contact at t, or 0 when they never meet.
+int wc_ccd_point_triangle(const double p0[3], const double p1[3], const double a0[3],
+                          const double a1[3], const double b0[3], const double b1[3],
+                          const double c0[3], const double c1[3], double tolerance, double *t,
+                          double bary[3]);
+
+/// Earliest time t in [0, 1] at which edges p-q and r-s, moving linearly,
+/// are coplanar and within `tolerance` of each other. Returns 1 and writes t
+/// and the parameters along each edge at that time, or 0.
+int wc_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
+                     const double q1[3], const double r0[3], const double r1[3],
+                     const double s0[3], const double s1[3], double tolerance, double *t,
+                     double *u, double *v);
+
+/// Unit normal of triangle (a, b, c) (right-handed); zero vector when degenerate.
+void wc_triangle_normal(const double a[3], const double b[3], const double c[3], double n[3]);
+
+#endif

@@ -1,0 +1,1370 @@
+/* Self-collision of one cloth over one step (SPEC 2), after Bridson, Fedkiw
+ * & Anderson 2002, "Robust treatment of collisions, contact and friction for
+ * cloth animation", with the normal-cone culling of Volino & Magnenat-
+ * Thalmann 1994 ("Efficient self-collision detection on smoothly
+ * discretized surface animations") in the broadphase:
+ *
+ *  1. Broadphase. The triangles are grouped once, in the rest shape, into
+ *     small connected patches (about 4 x 4 quads). Every particle gets a box
+ *     around its motion x -> nx, grown by a margin g; patches get the union
+ *     of their particles' boxes and a cone that holds every triangle normal
+ *     of the patch over the whole step. A connected piece of surface whose
+ *     normals all stay within 90 degrees of one direction is a height field
+ *     over the plane across it and cannot pass through itself; within 60
+ *     degrees it cannot even bring two points closer than half their
+ *     distance along the surface (see REST_EXCLUSION). So a patch with a
+ *     narrow cone, and two neighbouring patches (sharing a vertex) whose
+ *     joint cone is narrow, need no element tests at all. Only the other
+ *     pairs of patches whose boxes come within the thickness h (a uniform
+ *     grid finds them) are opened up into vertex-face pairs (vertex not a
+ *     corner of the face) and edge-edge pairs (no shared vertex) with
+ *     overlapping boxes. A falling or draped cloth costs a pass over its
+ *     particles and triangles; folds cost what they touch.
+ *     The candidates stay valid while every particle stays inside its box
+ *     and the culled patches keep their narrow cones; a response that breaks
+ *     either triggers a rebuild.
+ *  2. Passes. Each pass evaluates (in parallel, one status byte per pair)
+ *     the pairs with a particle that moved since their last evaluation: a
+ *     continuous test of the step's motion (the coplanarity cubic) and, when
+ *     that finds nothing, the distance at the end of the step. Then, serially
+ *     and in candidate order (so the result does not depend on the thread
+ *     count), each flagged pair is evaluated again against the current state
+ *     and answered with an inelastic impulse and Coulomb friction; impulses
+ *     are split by inverse mass with the barycentric weights (Bridson et al.
+ *     eq. 4).
+ *  3. Fail-safe. Pairs whose motion still collides after the passes put
+ *     their particles back where the step started, at rest: the start state
+ *     was free of intersection. Reverted particles can now be hit by moving
+ *     neighbours, so detection repeats until nothing collides (in the worst
+ *     case the whole cloth stays where it was).
+ *
+ * Everything works in displacements over the step, u = nx - x (= v dt): an
+ * impulse on the velocity is a change of nx, so dt drops out. A change of nx
+ * alone changes the velocity the next step starts with (it comes from
+ * nx - px at commit); a position correction that must not become velocity
+ * shifts the history override q by the same amount.
+ *
+ * The side a vertex is on comes from the start of the step: every contact
+ * normal is oriented so that the relative position of the two contact
+ * points at the start of the step lies on its positive side, and responses
+ * only push along it, so nothing is pushed across. */
+#include "selfcollide.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "grid.h"
+#include "parallel.h"
+#include "primitives.h"
+
+/* Response passes before the fail-safe. Each pass re-evaluates only what
+ * moved, so the later passes are cheap. */
+#define SELF_PASSES 4
+/* Variable-length outputs of parallel loops (candidate pairs) are written
+ * per slice of the loop, slices being fixed ranges independent of the thread
+ * count, and concatenated in slice order: the same order as a serial loop. */
+#define SLICES 64
+/* Margin g around each particle's motion, as a fraction of the thickness:
+ * responses that stay within it need no new broadphase. */
+#define BOX_MARGIN 0.25
+/* Pairs closer than this many thicknesses in the rest shape are neighbours
+ * in the cloth itself (for instance across a quad's diagonal): the cloth's
+ * own links keep them apart, so they get no proximity repulsion, which would
+ * fight those links. They still get the continuous test. With 2, and culled
+ * patches whose normals stay within 60 degrees of a common direction (so
+ * distances in space are at least cos 60 = 1/2 of those along the surface),
+ * no culled pair that is not such a neighbour can be within h unless the
+ * cloth is compressed. */
+#define REST_EXCLUSION 2.0
+/* Largest angle between a culled region's normals and its cone axis. */
+#define CONE_COS 0.5
+/* Patches: triangles binned by rest centroid into cubes of this many mean
+ * edge lengths, split into connected pieces of at most PATCH_MAX triangles. */
+#define PATCH_CELL_EDGES 4.0
+#define PATCH_MAX 64
+/* The continuous test counts a coplanarity as a collision when the two
+ * elements are within this fraction of the thickness. */
+#define CCD_TOLERANCE 0.01
+/* Smallest thickness used, as a fraction of the mean rest edge length:
+ * a thickness of zero would let responses stop two layers exactly touching. */
+#define MIN_THICKNESS 0.01
+
+typedef struct pair_slice {
+    int32_t *pairs;
+    int64_t count, capacity;
+    int32_t *query;
+    int32_t query_capacity;
+    int failed;
+} pair_slice;
+
+/* Compressed lists: the items of list k are items[start[k] .. start[k+1]). */
+typedef struct csr {
+    int32_t *start;
+    int32_t *items;
+} csr;
+
+struct wc_self_state {
+    int32_t particle_count, triangle_count, edge_count, patch_count;
+    /// The cloth's triangles (owned by its topology).
+    const int32_t *triangles;
+    /// Unique edges of the triangles, 2 particles each (lower index first).
+    int32_t *edges;
+    /// The 3 edge ids of each triangle (edge k joins corners k and k+1).
+    int32_t *triangle_edges;
+    /// Lowest-index triangle holding each edge.
+    int32_t *edge_owner;
+    /// Rest shape (positions at creation), xyz per particle.
+    double *rest;
+    double mean_edge;
+
+    /* Patches (built once). */
+    int32_t *triangle_patch;
+    /// Triangles of each patch, all its particles, the particles it owns
+    /// (those whose lowest-index triangle it holds), the edges it owns (the
+    /// patch of the edge's owner triangle), and the patches sharing a
+    /// particle with it (ascending, itself excluded). Owned particles and
+    /// edges are tested once, from their own patch.
+    csr patch_triangles, patch_particles, patch_owned_particles, patch_owned_edges, patch_adjacent;
+
+    /* Per step. */
+    /// Particle boxes (motion grown by g); triangle boxes (corners' boxes
+    /// grown by h); edge boxes (ends' boxes).
+    double *particle_boxes, *triangle_boxes, *edge_boxes;
+    /// Per triangle: normal at the start (3) and end (3) of the step, their
+    /// lengths, and a quarter of the length of the t^2 term of the normal
+    /// over the step (the bound on how far it bulges between the two).
+    double *triangle_normals;
+    /// Per patch: box (union of its particles' boxes), the same grown by h
+    /// (the grid indexes those), cone axis, and a lower bound on the cosine
+    /// of the angle between the axis and any of its normals over the step.
+    double *patch_boxes, *patch_grown, *patch_axis, *patch_cos;
+    /// Culling decisions of the current broadphase: the patch alone, and
+    /// each adjacency entry (overlapping neighbours culled together).
+    uint8_t *patch_culled, *adjacent_culled, *patch_touched;
+    wc_grid patch_grid;
+    /// Patch pairs (P <= Q) opened up into element pairs.
+    int32_t *open;
+    int64_t open_count, open_capacity;
+    pair_slice slices[SLICES];
+    /// Candidates: vertex-face (vertex, triangle) and edge-edge (edge, edge)
+    /// pairs, with the status of their last evaluation (0 none, 1 proximity,
+    /// 2 collision during the step).
+    int32_t *vf, *ee;
+    uint8_t *vf_status, *ee_status;
+    int64_t vf_count, vf_capacity, ee_count, ee_capacity;
+    /// Per particle: moved since its pairs were last evaluated; put back by
+    /// the fail-safe.
+    uint8_t *dirty, *reverted;
+};
+
+/* ------------------------------------------------------------------------ */
+/* Small vector helpers                                                     */
+/* ------------------------------------------------------------------------ */
+
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void cross3(const double a[3], const double b[3], double out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static void load(const double *x, const double *y, const double *z, int32_t i, double out[3])
+{
+    out[0] = x[i], out[1] = y[i], out[2] = z[i];
+}
+
+static void lerp3(const double a[3], const double b[3], double t, double out[3])
+{
+    for (int k = 0; k < 3; ++k) out[k] = a[k] + (b[k] - a[k]) * t;
+}
+
+/* fmin/fmax without their NaN rules, which keep them from being inlined;
+ * every input here is finite. */
+static double min2(double a, double b) { return a < b ? a : b; }
+static double max2(double a, double b) { return a > b ? a : b; }
+
+static double dist3(const double a[3], const double b[3])
+{
+    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return sqrt(dot3(d, d));
+}
+
+/* Scales v to unit length; returns 0 (v untouched) when it is zero. */
+static int normalize3(double v[3])
+{
+    double len = sqrt(dot3(v, v));
+    if (!(len > 0.0) || !isfinite(len)) return 0;
+    for (int k = 0; k < 3; ++k) v[k] /= len;
+    return 1;
+}
+
+/* Whether a (grown by margin) and b overlap. */
+static int boxes_overlap_by(const double a[6], const double b[6], double margin)
+{
+    return a[0] - margin <= b[3] && b[0] <= a[3] + margin && a[1] - margin <= b[4] &&
+           b[1] <= a[4] + margin && a[2] - margin <= b[5] && b[2] <= a[5] + margin;
+}
+
+static void union_box(double box[6], const double add[6])
+{
+    for (int k = 0; k < 3; ++k) {
+        if (add[k] < box[k]) box[k] = add[k];
+        if (add[k + 3] > box[k + 3]) box[k + 3] = add[k + 3];
+    }
+}
+
+/* Grows an int32 buffer to hold at least `needed` elements, keeping its
+ * contents; doubles so that growth is rare. */
+static int grow_int32(int32_t **buf, int64_t *capacity, int64_t needed)
+{
+    if (needed <= *capacity) return 1;
+    int64_t cap = *capacity > 0 ? *capacity : 256;
+    while (cap < needed) cap *= 2;
+    int32_t *p = wc_alloc_array((size_t)cap, sizeof *p);
+    if (!p) return 0;
+    if (*capacity > 0) memcpy(p, *buf, (size_t)*capacity * sizeof *p);
+    wc_free(*buf);
+    *buf = p;
+    *capacity = cap;
+    return 1;
+}
+
+static int sorted_contains(const int32_t *list, int32_t count, int32_t item)
+{
+    int32_t lo = 0, hi = count;
+    while (lo < hi) {
+        int32_t mid = (lo + hi) / 2;
+        if (list[mid] < item) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < count && list[lo] == item ? lo : -1;
+}
+
+static void csr_free(csr *c)
+{
+    wc_free(c->start);
+    wc_free(c->items);
+    c->start = c->items = NULL;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Edges and patches (built once)                                           */
+/* ------------------------------------------------------------------------ */
+
+/* Sorts pairs (key, value) of int32 by key then value. */
+static int compare_pairs(const void *pa, const void *pb)
+{
+    const int32_t *p = pa, *q = pb;
+    if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
+    return p[1] < q[1] ? -1 : (p[1] > q[1]);
+}
+
+/* Builds a CSR of `lists` lists from (list, item) pairs; with `unique`,
+ * repeated pairs are dropped. Items come out ascending. */
+static int csr_from_pairs(csr *out, int32_t lists, int32_t *pairs, int64_t count, int unique)
+{
+    qsort(pairs, (size_t)count, 2 * sizeof *pairs, compare_pairs);
+    out->start = wc_alloc_array((size_t)lists + 1, sizeof *out->start);
+    out->items = wc_alloc_array((size_t)count, sizeof *out->items);
+    if (!out->start || !out->items) return 0;
+    int64_t n = 0;
+    for (int64_t k = 0; k < count; ++k) {
+        if (unique && k > 0 && pairs[2 * k] == pairs[2 * k - 2] && pairs[2 * k + 1] == pairs[2 * k - 1])
+            continue;
+        out->start[pairs[2 * k] + 1]++;
+        out->items[n++] = pairs[2 * k + 1];
+    }
+    for (int32_t k = 0; k < lists; ++k) out->start[k + 1] += out->start[k];
+    return 1;
+}
+
+typedef struct edge_entry {
+    int32_t a, b, triangle, slot;
+} edge_entry;
+
+static int compare_edge_entries(const void *pa, const void *pb)
+{
+    const edge_entry *p = pa, *q = pb;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    if (p->b != q->b) return p->b < q->b ? -1 : 1;
+    if (p->triangle != q->triangle) return p->triangle < q->triangle ? -1 : 1;
+    return p->slot < q->slot ? -1 : (p->slot > q->slot);
+}
+
+/* The unique edges of the triangles, each triangle's edge ids, each edge's
+ * owner triangle, and (for growing patches) each triangle's neighbours
+ * across edges shared by exactly two triangles. */
+static int build_edges(wc_self_state *s, const wc_cloth *c, int32_t *neighbours)
+{
+    int32_t t_count = s->triangle_count;
+    size_t entries = 3 * (size_t)t_count;
+    edge_entry *e = wc_alloc_array(entries, sizeof *e);
+    s->triangle_edges = wc_alloc_array(entries, sizeof *s->triangle_edges);
+    if (!e || !s->triangle_edges) {
+        wc_free(e);
+        return 0;
+    }
+    for (int32_t t = 0; t < t_count; ++t)
+        for (int k = 0; k < 3; ++k) {
+            int32_t a = s->triangles[3 * (size_t)t + k], b = s->triangles[3 * (size_t)t + (k + 1) % 3];
+            edge_entry *x = e + 3 * (size_t)t + k;
+            x->a = a < b ? a : b, x->b = a < b ? b : a, x->triangle = t, x->slot = k;
+        }
+    qsort(e, entries, sizeof *e, compare_edge_entries);
+    int32_t unique = 0;
+    for (size_t k = 0; k < entries; ++k)
+        if (k == 0 || e[k].a != e[k - 1].a || e[k].b != e[k - 1].b) ++unique;
+    s->edge_count = unique;
+    s->edges = wc_alloc_array(2 * (size_t)unique, sizeof *s->edges);
+    s->edge_owner = wc_alloc_array((size_t)unique, sizeof *s->edge_owner);
+    if (!s->edges || !s->edge_owner) {
+        wc_free(e);
+        return 0;
+    }
+    for (size_t k = 0; k < entries; ++k) neighbours[k] = -1;
+    int32_t id = -1;
+    double total = 0.0;
+    for (size_t k = 0; k < entries; ++k) {
+        int first = k == 0 || e[k].a != e[k - 1].a || e[k].b != e[k - 1].b;
+        if (first) {
+            ++id;
+            s->edges[2 * (size_t)id] = e[k].a;
+            s->edges[2 * (size_t)id + 1] = e[k].b;
+            s->edge_owner[id] = e[k].triangle; /* sorted by triangle: the lowest */
+            double pa[3], pb[3];
+            load(c->x, c->y, c->z, e[k].a, pa);
+            load(c->x, c->y, c->z, e[k].b, pb);
+            total += dist3(pa, pb);
+            /* manifold edge: exactly two triangles */
+            int two = k + 1 < entries && e[k + 1].a == e[k].a && e[k + 1].b == e[k].b &&
+                      !(k + 2 < entries && e[k + 2].a == e[k].a && e[k + 2].b == e[k].b);
+            if (two) {
+                neighbours[3 * (size_t)e[k].triangle + e[k].slot] = e[k + 1].triangle;
+                neighbours[3 * (size_t)e[k + 1].triangle + e[k + 1].slot] = e[k].triangle;
+            }
+        }
+        s->triangle_edges[3 * (size_t)e[k].triangle + e[k].slot] = id;
+    }
+    s->mean_edge = unique ? total / unique : 0.0;
+    wc_free(e);
+    return 1;
+}
+
+/* Bin of a triangle: its rest centroid's cube of side `cell`, as a key that
+ * sorts the same on every platform. */
+static void triangle_bin(const wc_self_state *s, int32_t t, double cell, int64_t key[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        double m = 0.0;
+        for (int j = 0; j < 3; ++j) m += s->rest[3 * (size_t)s->triangles[3 * (size_t)t + j] + k];
+        double b = floor(m / 3.0 / cell);
+        key[k] = b < -1e15 ? (int64_t)-1e15 : b > 1e15 ? (int64_t)1e15 : (int64_t)b;
+    }
+}
+
+typedef struct bin_entry {
+    int64_t key[3];
+    int32_t triangle, bin;
+} bin_entry;
+
+static int compare_bins(const void *pa, const void *pb)
+{
+    const bin_entry *p = pa, *q = pb;
+    for (int k = 0; k < 3; ++k)
+        if (p->key[k] != q->key[k]) return p->key[k] < q->key[k] ? -1 : 1;
+    return p->triangle < q->triangle ? -1 : (p->triangle > q->triangle);
+}
+
+/* Patches: the triangles of each bin, lowest index first, grown breadth-first
+ * across manifold edges within the bin up to PATCH_MAX triangles. Each patch
+ * is connected, which the culling needs. */
+static int build_patches(wc_self_state *s, const int32_t *neighbours)
+{
+    int32_t nt = s->triangle_count, n = s->particle_count;
+    double cell = PATCH_CELL_EDGES * (s->mean_edge > 0.0 ? s->mean_edge : 1.0);
+    bin_entry *bins = wc_alloc_array((size_t)nt, sizeof *bins);
+    int32_t *bin_of = wc_alloc_array((size_t)nt, sizeof *bin_of);
+    int32_t *queue = wc_alloc_array((size_t)nt, sizeof *queue);
+    s->triangle_patch = wc_alloc_array((size_t)nt, sizeof *s->triangle_patch);
+    int ok = bins && bin_of && queue && s->triangle_patch;
+    if (ok) {
+        for (int32_t t = 0; t < nt; ++t) {
+            triangle_bin(s, t, cell, bins[t].key);
+            bins[t].triangle = t;
+            s->triangle_patch[t] = -1;
+        }
+        qsort(bins, (size_t)nt, sizeof *bins, compare_bins);
+        int32_t b = -1;
+        for (int32_t k = 0; k < nt; ++k) {
+            if (k == 0 || compare_bins(&bins[k], &bins[k - 1]) != 0) {
+                const int64_t *p = bins[k].key, *q = k ? bins[k - 1].key : NULL;
+                if (!q || p[0] != q[0] || p[1] != q[1] || p[2] != q[2]) ++b;
+            }
+            bin_of[bins[k].triangle] = b;
+        }
+        int32_t patches = 0;
+        for (int32_t k = 0; k < nt; ++k) {
+            int32_t seed = bins[k].triangle;
+            if (s->triangle_patch[seed] >= 0) continue;
+            int32_t head = 0, tail = 0, size = 0;
+            queue[tail++] = seed;
+            s->triangle_patch[seed] = patches;
+            while (head < tail && size < PATCH_MAX) {
+                int32_t t = queue[head++];
+                ++size;
+                for (int j = 0; j < 3; ++j) {
+                    int32_t u = neighbours[3 * (size_t)t + j];
+                    if (u < 0 || s->triangle_patch[u] >= 0 || bin_of[u] != bin_of[t]) continue;
+                    if (size + (tail - head) >= PATCH_MAX) continue;
+                    s->triangle_patch[u] = patches;
+                    queue[tail++] = u;
+                }
+            }
+            /* Queued beyond the limit (none, by the check above) would be
+             * released here; the patch is exactly queue[0 .. tail). */
+            ++patches;
+        }
+        s->patch_count = patches;
+    }
+    wc_free(bins);
+    wc_free(bin_of);
+    wc_free(queue);
+    if (!ok) return 0;
+
+    /* Lists per patch, from (patch, item) pairs. */
+    int32_t np = s->patch_count;
+    size_t most = 3 * (size_t)nt > (size_t)s->edge_count ? 3 * (size_t)nt : (size_t)s->edge_count;
+    int32_t *pairs = wc_alloc_array(2 * most, sizeof *pairs);
+    int32_t *owner = wc_alloc_array((size_t)n, sizeof *owner);
+    if (!pairs || !owner) {
+        wc_free(pairs);
+        wc_free(owner);
+        return 0;
+    }
+    for (int32_t t = 0; t < nt; ++t) pairs[2 * t] = s->triangle_patch[t], pairs[2 * t + 1] = t;
+    ok = csr_from_pairs(&s->patch_triangles, np, pairs, nt, 0);
+    for (int32_t t = 0; t < nt && ok; ++t)
+        for (int j = 0; j < 3; ++j) {
+            pairs[2 * (3 * (size_t)t + j)] = s->triangle_patch[t];
+            pairs[2 * (3 * (size_t)t + j) + 1] = s->triangles[3 * (size_t)t + j];
+        }
+    ok = ok && csr_from_pairs(&s->patch_particles, np, pairs, 3 * (int64_t)nt, 1);
+    /* owner triangle of a particle: its lowest-index triangle */
+    for (int32_t i = 0; i < n; ++i) owner[i] = -1;
+    for (int32_t t = nt - 1; t >= 0; --t)
+        for (int j = 0; j < 3; ++j) owner[s->triangles[3 * (size_t)t + j]] = t;
+    int64_t owned = 0;
+    for (int32_t i = 0; i < n && ok; ++i)
+        if (owner[i] >= 0) pairs[2 * owned] = s->triangle_patch[owner[i]], pairs[2 * owned + 1] = i, ++owned;
+    ok = ok && csr_from_pairs(&s->patch_owned_particles, np, pairs, owned, 0);
+    for (int32_t e = 0; e < s->edge_count && ok; ++e)
+        pairs[2 * e] = s->triangle_patch[s->edge_owner[e]], pairs[2 * e + 1] = e;
+    ok = ok && csr_from_pairs(&s->patch_owned_edges, np, pairs, s->edge_count, 0);
+    wc_free(pairs);
+    wc_free(owner);
+    if (!ok) return 0;
+
+    /* Adjacency: patches sharing a particle. Invert the particle lists, then
+     * pair up the patches of each particle. */
+    csr of_particle = {NULL, NULL};
+    int64_t entries = s->patch_particles.start[np];
+    pairs = wc_alloc_array(2 * (size_t)entries, sizeof *pairs);
+    if (!pairs) return 0;
+    for (int32_t p = 0; p < np; ++p)
+        for (int32_t k = s->patch_particles.start[p]; k < s->patch_particles.start[p + 1]; ++k)
+            pairs[2 * (size_t)k] = s->patch_particles.items[k], pairs[2 * (size_t)k + 1] = p;
+    ok = csr_from_pairs(&of_particle, n, pairs, entries, 0);
+    wc_free(pairs);
+    int64_t links = 0;
+    for (int32_t i = 0; i < n && ok; ++i) {
+        int64_t m = of_particle.start[i + 1] - of_particle.start[i];
+        links += m * (m - 1);
+    }
+    pairs = ok ? wc_alloc_array(2 * (size_t)(links > 0 ? links : 1), sizeof *pairs) : NULL;
+    if (pairs) {
+        int64_t at = 0;
+        for (int32_t i = 0; i < n; ++i)
+            for (int32_t a = of_particle.start[i]; a < of_particle.start[i + 1]; ++a)
+                for (int32_t b = of_particle.start[i]; b < of_particle.start[i + 1]; ++b)
+                    if (a != b)
+                        pairs[2 * at] = of_particle.items[a], pairs[2 * at + 1] = of_particle.items[b], ++at;
+        ok = csr_from_pairs(&s->patch_adjacent, np, pairs, links, 1);
+    } else {
+        ok = 0;
+    }
+    wc_free(pairs);
+    csr_free(&of_particle);
+    return ok;
+}
+
+wc_self_state *wc_self_state_create(const wc_cloth *c)
+{
+    wc_self_state *s = wc_alloc_array(1, sizeof *s);
+    if (!s) return NULL;
+    size_t n = (size_t)c->particle_count, nt = (size_t)c->topology.triangle_count;
+    s->particle_count = c->particle_count;
+    s->triangle_count = c->topology.triangle_count;
+    s->triangles = c->topology.triangles;
+    wc_grid_init(&s->patch_grid);
+    s->rest = wc_alloc_array(3 * n, sizeof *s->rest);
+    int32_t *neighbours = wc_alloc_array(3 * nt, sizeof *neighbours);
+    int ok = s->rest && neighbours && build_edges(s, c, neighbours);
+    if (ok) {
+        for (size_t i = 0; i < n; ++i) load(c->x, c->y, c->z, (int32_t)i, s->rest + 3 * i);
+        ok = build_patches(s, neighbours);
+    }
+    wc_free(neighbours);
+    if (!ok) {
+        wc_self_state_destroy(s);
+        return NULL;
+    }
+    size_t np = (size_t)s->patch_count, adjacency = (size_t)s->patch_adjacent.start[np];
+    s->particle_boxes = wc_alloc_array(6 * n, sizeof *s->particle_boxes);
+    s->triangle_boxes = wc_alloc_array(6 * nt, sizeof *s->triangle_boxes);
+    s->edge_boxes = wc_alloc_array(6 * (size_t)s->edge_count, sizeof *s->edge_boxes);
+    s->triangle_normals = wc_alloc_array(9 * nt, sizeof *s->triangle_normals);
+    s->patch_boxes = wc_alloc_array(6 * np, sizeof *s->patch_boxes);
+    s->patch_grown = wc_alloc_array(6 * np, sizeof *s->patch_grown);
+    s->patch_axis = wc_alloc_array(3 * np, sizeof *s->patch_axis);
+    s->patch_cos = wc_alloc_array(np, sizeof *s->patch_cos);
+    s->patch_culled = wc_alloc_array(np, 1);
+    s->patch_touched = wc_alloc_array(np, 1);
+    s->adjacent_culled = wc_alloc_array(adjacency, 1);
+    s->dirty = wc_alloc_array(n, 1);
+    s->reverted = wc_alloc_array(n, 1);
+    if (!s->particle_boxes || !s->triangle_boxes || !s->edge_boxes || !s->triangle_normals ||
+        !s->patch_boxes || !s->patch_grown || !s->patch_axis || !s->patch_cos ||
+        !s->patch_culled || !s->patch_touched || !s->adjacent_culled || !s->dirty || !s->reverted) {
+        wc_self_state_destroy(s);
+        return NULL;
+    }
+    return s;
+}
+
+void wc_self_state_destroy(wc_self_state *s)
+{
+    if (!s) return;
+    void *blocks[] = {s->edges, s->triangle_edges, s->edge_owner, s->rest, s->triangle_patch,
+                      s->particle_boxes, s->triangle_boxes, s->edge_boxes, s->triangle_normals,
+                      s->patch_boxes, s->patch_grown, s->patch_axis, s->patch_cos,
+                      s->patch_culled, s->adjacent_culled, s->patch_touched, s->open, s->vf,
+                      s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted};
+    for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
+    csr_free(&s->patch_triangles);
+    csr_free(&s->patch_particles);
+    csr_free(&s->patch_owned_particles);
+    csr_free(&s->patch_owned_edges);
+    csr_free(&s->patch_adjacent);
+    wc_grid_free(&s->patch_grid);
+    for (int k = 0; k < SLICES; ++k) {
+        wc_free(s->slices[k].pairs);
+        wc_free(s->slices[k].query);
+    }
+    wc_free(s);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Broadphase                                                               */
+/* ------------------------------------------------------------------------ */
+
+static void particle_box(const wc_cloth *c, int32_t i, double g, double box[6])
+{
+    double a[3], b[3];
+    load(c->x, c->y, c->z, i, a);
+    load(c->nx, c->ny, c->nz, i, b);
+    for (int k = 0; k < 3; ++k) {
+        box[k] = min2(a[k], b[k]) - g;
+        box[k + 3] = max2(a[k], b[k]) + g;
+    }
+}
+
+/* A triangle's normal over the step. With edge vectors linear in t, the
+ * (unnormalised) normal is n(t) = (1-t) n0 + t n1 - t(1-t) N2, N2 the cross
+ * product of the edges' changes; so |n(t) - lerp(n0, n1)| <= |N2| / 4. */
+static void triangle_normal_motion(const wc_cloth *c, const int32_t *tri, double out[9])
+{
+    double a0[3], b0[3], c0[3], a1[3], b1[3], c1[3], e0[3], f0[3], e1[3], f1[3], de[3], df[3], n2[3];
+    load(c->x, c->y, c->z, tri[0], a0), load(c->x, c->y, c->z, tri[1], b0), load(c->x, c->y, c->z, tri[2], c0);
+    load(c->nx, c->ny, c->nz, tri[0], a1), load(c->nx, c->ny, c->nz, tri[1], b1), load(c->nx, c->ny, c->nz, tri[2], c1);
+    for (int k = 0; k < 3; ++k) {
+        e0[k] = b0[k] - a0[k], f0[k] = c0[k] - a0[k];
+        e1[k] = b1[k] - a1[k], f1[k] = c1[k] - a1[k];
+        de[k] = e1[k] - e0[k], df[k] = f1[k] - f0[k];
+    }
+    cross3(e0, f0, out);
+    cross3(e1, f1, out + 3);
+    cross3(de, df, n2);
+    out[6] = sqrt(dot3(out, out));
+    out[7] = sqrt(dot3(out + 3, out + 3));
+    out[8] = 0.25 * sqrt(dot3(n2, n2));
+}
+
+/* Lower bound of cos(angle(n(t), axis)) over the step; <= 0 when the normal
+ * may turn 90 degrees or more away from the axis (or vanish). */
+static double triangle_cos(const double nm[9], const double axis[3])
+{
+    double lo = min2(dot3(nm, axis), dot3(nm + 3, axis)) - nm[8];
+    double hi = max2(nm[6], nm[7]) + nm[8];
+    return lo > 0.0 && hi > 0.0 ? lo / hi : -1.0;
+}
+
+/* Cone axis (normalised sum of the unit normals at both ends of the step)
+ * and the cosine bound of a patch. */
+static void patch_cone(wc_self_state *s, int32_t p)
+{
+    double *axis = s->patch_axis + 3 * (size_t)p;
+    axis[0] = axis[1] = axis[2] = 0.0;
+    const csr *tris = &s->patch_triangles;
+    for (int32_t k = tris->start[p]; k < tris->start[p + 1]; ++k) {
+        const double *nm = s->triangle_normals + 9 * (size_t)tris->items[k];
+        for (int m = 0; m < 3; ++m) {
+            if (nm[6] > 0.0) axis[m] += nm[m] / nm[6];
+            if (nm[7] > 0.0) axis[m] += nm[3 + m] / nm[7];
+        }
+    }
+    double cosine = -1.0;
+    if (normalize3(axis)) {
+        cosine = 1.0;
+        for (int32_t k = tris->start[p]; k < tris->start[p + 1] && cosine > 0.0; ++k)
+            cosine = min2(cosine, triangle_cos(s->triangle_normals + 9 * (size_t)tris->items[k], axis));
+    }
+    s->patch_cos[p] = cosine;
+}
+
+/* Whether two patches' cones fit in one cone of half-angle acos(CONE_COS):
+ * around the bisector d of the axes, a normal is at most its patch's
+ * half-angle plus half the angle between the axes away from d. */
+static int cones_join(const wc_self_state *s, int32_t p, int32_t q)
+{
+    double cp = s->patch_cos[p], cq = s->patch_cos[q];
+    if (!(cp > CONE_COS && cq > CONE_COS)) return 0;
+    double between = dot3(s->patch_axis + 3 * (size_t)p, s->patch_axis + 3 * (size_t)q);
+    if (between > 1.0) between = 1.0;
+    if (between < -1.0) between = -1.0;
+    double spread = acos(min2(cp, cq)) + 0.5 * acos(between);
+    return spread < acos(CONE_COS);
+}
+
+/* Patch-level pairs of the patches in [first, end): for each P, every
+ * Q >= P whose grown box meets P's box. Pushes (P, Q) for a pair to open,
+ * (P, ~Q) for neighbours culled together. */
+static void patch_pairs_slice(wc_self_state *s, pair_slice *sl, int32_t first, int32_t end)
+{
+    for (int32_t p = first; p < end && !sl->failed; ++p) {
+        int32_t found;
+        for (;;) {
+            found = wc_grid_query(&s->patch_grid, s->patch_boxes + 6 * (size_t)p, sl->query,
+                                  sl->query_capacity);
+            if (found <= sl->query_capacity) break;
+            int64_t cap = sl->query_capacity;
+            if (!grow_int32(&sl->query, &cap, found)) {
+                sl->failed = 1;
+                return;
+            }
+            sl->query_capacity = (int32_t)cap;
+        }
+        const int32_t *adj = s->patch_adjacent.items + s->patch_adjacent.start[p];
+        int32_t adj_count = s->patch_adjacent.start[p + 1] - s->patch_adjacent.start[p];
+        for (int32_t k = 0; k < found; ++k) {
+            int32_t q = sl->query[k];
+            if (q < p) continue;
+            if (q == p) {
+                if (!(s->patch_cos[p] > CONE_COS)) {
+                    if (!grow_int32(&sl->pairs, &sl->capacity, 2 * (sl->count + 1))) sl->failed = 1;
+                    else sl->pairs[2 * sl->count] = p, sl->pairs[2 * sl->count + 1] = p, sl->count++;
+                }
+                continue;
+            }
+            int culled = sorted_contains(adj, adj_count, q) >= 0 && cones_join(s, p, q);
+            if (!grow_int32(&sl->pairs, &sl->capacity, 2 * (sl->count + 1))) {
+                sl->failed = 1;
+                return;
+            }
+            sl->pairs[2 * sl->count] = p;
+            sl->pairs[2 * sl->count + 1] = culled ? ~q : q;
+            sl->count++;
+        }
+    }
+}
+
+/* Appends a pair to a slice; on out-of-memory marks the slice failed. */
+static void slice_push(pair_slice *sl, int32_t a, int32_t b)
+{
+    if (sl->failed) return;
+    if (!grow_int32(&sl->pairs, &sl->capacity, 2 * (sl->count + 1))) {
+        sl->failed = 1;
+        return;
+    }
+    sl->pairs[2 * sl->count] = a;
+    sl->pairs[2 * sl->count + 1] = b;
+    sl->count++;
+}
+
+/* Vertices of patch p (owned) against triangles of patch q. */
+static void open_vf(const wc_self_state *s, pair_slice *vf, int32_t p, int32_t q, double h)
+{
+    const csr *own = &s->patch_owned_particles, *tris = &s->patch_triangles;
+    const double *qbox = s->patch_boxes + 6 * (size_t)q;
+    for (int32_t a = own->start[p]; a < own->start[p + 1]; ++a) {
+        int32_t v = own->items[a];
+        const double *vbox = s->particle_boxes + 6 * (size_t)v;
+        if (!boxes_overlap_by(vbox, qbox, h)) continue;
+        for (int32_t b = tris->start[q]; b < tris->start[q + 1]; ++b) {
+            int32_t t = tris->items[b];
+            const int32_t *tri = s->triangles + 3 * (size_t)t;
+            if (tri[0] == v || tri[1] == v || tri[2] == v) continue;
+            if (boxes_overlap_by(vbox, s->triangle_boxes + 6 * (size_t)t, 0.0)) slice_push(vf, v, t);
+        }
+    }
+}
+
+/* Edges of patch p (owned) against edges of patch q (for p == q, each pair
+ * once). */
+static void open_ee(const wc_self_state *s, pair_slice *ee, int32_t p, int32_t q, double h)
+{
+    const csr *own = &s->patch_owned_edges;
+    const double *qbox = s->patch_boxes + 6 * (size_t)q;
+    for (int32_t a = own->start[p]; a < own->start[p + 1]; ++a) {
+        int32_t e = own->items[a];
+        const double *ebox = s->edge_boxes + 6 * (size_t)e;
+        if (!boxes_overlap_by(ebox, qbox, h)) continue;
+        int32_t ea = s->edges[2 * (size_t)e], eb = s->edges[2 * (size_t)e + 1];
+        for (int32_t b = p == q ? a + 1 : own->start[q]; b < own->start[q + 1]; ++b) {
+            int32_t f = own->items[b];
+            int32_t fa = s->edges[2 * (size_t)f], fb = s->edges[2 * (size_t)f + 1];
+            if (fa == ea || fa == eb || fb == ea || fb == eb) continue;
+            if (boxes_overlap_by(ebox, s->edge_boxes + 6 * (size_t)f, h)) slice_push(ee, e, f);
+        }
+    }
+}
+
+/* Concatenates slices in order into one list (with a status byte per pair
+ * when status is given). */
+static int gather(const pair_slice *slices, int32_t **pairs, uint8_t **status, int64_t *count,
+                  int64_t *capacity)
+{
+    int64_t total = 0;
+    for (int k = 0; k < SLICES; ++k) {
+        if (slices[k].failed) return 0;
+        total += slices[k].count;
+    }
+    if (total > *capacity) {
+        int64_t cap = *capacity > 0 ? *capacity : 1024;
+        while (cap < total) cap *= 2;
+        wc_free(*pairs);
+        *pairs = wc_alloc_array(2 * (size_t)cap, sizeof **pairs);
+        if (status) {
+            wc_free(*status);
+            *status = wc_alloc_array((size_t)cap, 1);
+        }
+        *capacity = (*pairs && (!status || *status)) ? cap : 0;
+        if (!*capacity) return 0;
+    }
+    int64_t at = 0;
+    for (int k = 0; k < SLICES; ++k) {
+        if (slices[k].count)
+            memcpy(*pairs + 2 * at, slices[k].pairs, 2 * (size_t)slices[k].count * sizeof **pairs);
+        at += slices[k].count;
+    }
+    *count = total;
+    if (status) memset(*status, 0, (size_t)total);
+    return 1;
+}
+
+/* Range k of SLICES equal parts of [0, count). */
+static int32_t slice_begin(int64_t count, int k) { return (int32_t)(count * k / SLICES); }
+
+/* Boxes, cones, culling and candidate pairs of the current motion x -> nx. */
+static wc_status broadphase(wc_self_state *s, const wc_cloth *c, double h, double g, int threads)
+{
+    int32_t n = s->particle_count, nt = s->triangle_count, np = s->patch_count;
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
+    for (int32_t i = 0; i < n; ++i) particle_box(c, i, g, s->particle_boxes + 6 * (size_t)i);
+#pragma omp parallel for schedule(static) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
+    for (int32_t t = 0; t < nt; ++t) {
+        const int32_t *tri = s->triangles + 3 * (size_t)t;
+        triangle_normal_motion(c, tri, s->triangle_normals + 9 * (size_t)t);
+        double *box = s->triangle_boxes + 6 * (size_t)t;
+        memcpy(box, s->particle_boxes + 6 * (size_t)tri[0], 6 * sizeof *box);
+        union_box(box, s->particle_boxes + 6 * (size_t)tri[1]);
+        union_box(box, s->particle_boxes + 6 * (size_t)tri[2]);
+        for (int k = 0; k < 3; ++k) box[k] -= h, box[k + 3] += h;
+    }
+    /* Per patch: box, cone, and the boxes of the edges it owns. */
+#pragma omp parallel for schedule(static) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
+    for (int32_t p = 0; p < np; ++p) {
+        double *box = s->patch_boxes + 6 * (size_t)p;
+        const csr *pp = &s->patch_particles, *pe = &s->patch_owned_edges;
+        memcpy(box, s->particle_boxes + 6 * (size_t)pp->items[pp->start[p]], 6 * sizeof *box);
+        for (int32_t k = pp->start[p] + 1; k < pp->start[p + 1]; ++k)
+            union_box(box, s->particle_boxes + 6 * (size_t)pp->items[k]);
+        double *grown = s->patch_grown + 6 * (size_t)p;
+        for (int k = 0; k < 3; ++k) grown[k] = box[k] - h, grown[k + 3] = box[k + 3] + h;
+        patch_cone(s, p);
+        for (int32_t k = pe->start[p]; k < pe->start[p + 1]; ++k) {
+            int32_t e = pe->items[k];
+            double *eb = s->edge_boxes + 6 * (size_t)e;
+            memcpy(eb, s->particle_boxes + 6 * (size_t)s->edges[2 * (size_t)e], 6 * sizeof *eb);
+            union_box(eb, s->particle_boxes + 6 * (size_t)s->edges[2 * (size_t)e + 1]);
+        }
+    }
+    /* Patch grid: cells about one grown patch box across (serial sum, so the
+     * same bits for any thread count; the query results do not depend on it
+     * anyway). */
+    double extent = 0.0;
+    for (int32_t p = 0; p < np; ++p) {
+        const double *b = s->patch_grown + 6 * (size_t)p;
+        extent += max2(b[3] - b[0], max2(b[4] - b[1], b[5] - b[2]));
+    }
+    double cell = np ? extent / np : 1.0;
+    if (!(cell > 0.0) || !isfinite(cell)) cell = 1.0;
+    if (wc_grid_build(&s->patch_grid, s->patch_grown, np, cell)) return WC_ERROR_OUT_OF_MEMORY;
+
+    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
+    for (int k = 0; k < SLICES; ++k)
+        patch_pairs_slice(s, &s->slices[k], slice_begin(np, k), slice_begin(np, k + 1));
+    if (!gather(s->slices, &s->open, NULL, &s->open_count, &s->open_capacity))
+        return WC_ERROR_OUT_OF_MEMORY;
+    /* Culling decisions (serial: few), and the pairs to open, compacted. */
+    for (int32_t p = 0; p < np; ++p) s->patch_culled[p] = s->patch_cos[p] > CONE_COS;
+    memset(s->adjacent_culled, 0, (size_t)s->patch_adjacent.start[np]);
+    int64_t open = 0;
+    for (int64_t k = 0; k < s->open_count; ++k) {
+        int32_t p = s->open[2 * k], q = s->open[2 * k + 1];
+        if (q >= 0) {
+            s->open[2 * open] = p, s->open[2 * open + 1] = q, ++open;
+            continue;
+        }
+        q = ~q;
+        const csr *adj = &s->patch_adjacent;
+        int32_t at = sorted_contains(adj->items + adj->start[p], adj->start[p + 1] - adj->start[p], q);
+        int32_t back = sorted_contains(adj->items + adj->start[q], adj->start[q + 1] - adj->start[q], p);
+        s->adjacent_culled[adj->start[p] + at] = 1;
+        s->adjacent_culled[adj->start[q] + back] = 1;
+    }
+    s->open_count = open;
+
+    /* Element pairs of the opened patch pairs: vertex-face both ways, then
+     * edge-edge; slices over the opened pairs write vertex-face pairs into
+     * their own buffers and edge-edge pairs into the second half. */
+    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (open >= 64)
+    for (int k = 0; k < SLICES; ++k)
+        for (int64_t m = slice_begin(open, k); m < slice_begin(open, k + 1); ++m) {
+            int32_t p = s->open[2 * m], q = s->open[2 * m + 1];
+            open_vf(s, &s->slices[k], p, q, h);
+            if (p != q) open_vf(s, &s->slices[k], q, p, h);
+        }
+    if (!gather(s->slices, &s->vf, &s->vf_status, &s->vf_count, &s->vf_capacity))
+        return WC_ERROR_OUT_OF_MEMORY;
+    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (open >= 64)
+    for (int k = 0; k < SLICES; ++k)
+        for (int64_t m = slice_begin(open, k); m < slice_begin(open, k + 1); ++m)
+            open_ee(s, &s->slices[k], s->open[2 * m], s->open[2 * m + 1], h);
+    if (!gather(s->slices, &s->ee, &s->ee_status, &s->ee_count, &s->ee_capacity))
+        return WC_ERROR_OUT_OF_MEMORY;
+    return WC_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Narrow phase                                                             */
+/* ------------------------------------------------------------------------ */
+
+typedef struct self_ctx {
+    const double *x, *y, *z, *nx, *ny, *nz;
+    const double *rest;
+    /// Thickness, CCD tolerance, squared rest distance below which pairs get
+    /// no proximity response.
+    double h, tol, exclude2;
+} self_ctx;
+
+enum { NO_CONTACT = 0, PROXIMITY = 1, COLLISION = 2 };
+
+/* A contact between two points of the cloth: the first is sum w_k X_k over
+ * w_k > 0, the second over w_k < 0; their relative position D = sum w_k X_k.
+ * n is unit (or zero when no direction could be found), with D at the start
+ * of the step on its positive side; d0 = D(start) . n. */
+typedef struct self_contact {
+    int kind;
+    int32_t p[4];
+    double w[4];
+    double n[3];
+    double d0;
+} self_contact;
+
+static void relative(const double *x, const double *y, const double *z, const self_contact *k,
+                     double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    for (int j = 0; j < 4; ++j) {
+        out[0] += k->w[j] * x[k->p[j]];
+        out[1] += k->w[j] * y[k->p[j]];
+        out[2] += k->w[j] * z[k->p[j]];
+    }
+}
+
+/* Orients n so that the start-of-step relative position is on its positive
+ * side (the side each element was on), or, when the start gives no side,
+ * so that the elements approach along it. */
+static void orient(const self_ctx *ctx, self_contact *k)
+{
+    double d0[3];
+    relative(ctx->x, ctx->y, ctx->z, k, d0);
+    double s = dot3(d0, k->n);
+    if (s == 0.0) {
+        double d1[3];
+        relative(ctx->nx, ctx->ny, ctx->nz, k, d1);
+        s = -dot3(d1, k->n); /* approaching: D . n decreases */
+    }
+    if (s < 0.0)
+        for (int m = 0; m < 3; ++m) k->n[m] = -k->n[m];
+    k->d0 = fabs(dot3(d0, k->n));
+}
+
+/* Fallback normal: the relative position at time t (contact points), else at
+ * the start. */
+static void fallback_normal(const self_ctx *ctx, self_contact *k, double t)
+{
+    double d0[3], d1[3];
+    relative(ctx->x, ctx->y, ctx->z, k, d0);
+    relative(ctx->nx, ctx->ny, ctx->nz, k, d1);
+    lerp3(d0, d1, t, k->n);
+    if (normalize3(k->n)) return;
+    memcpy(k->n, d0, sizeof d0);
+    if (!normalize3(k->n)) k->n[0] = k->n[1] = k->n[2] = 0.0;
+}
+
+static double max_relative_motion(double u[4][3], int first_count)
+{
+    /* Largest |u_i - u_j| with i among the first group and j in the second:
+     * it bounds how fast the distance between the two elements changes. */
+    double l2 = 0.0;
+    for (int i = 0; i < first_count; ++i)
+        for (int j = first_count; j < 4; ++j) {
+            double d[3] = {u[i][0] - u[j][0], u[i][1] - u[j][1], u[i][2] - u[j][2]};
+            double m = dot3(d, d);
+            if (m > l2) l2 = m;
+        }
+    return sqrt(l2);
+}
+
+/* Vertex v against triangle tri. With ccd_only, proximity is not looked at. */
+static int eval_vf(const self_ctx *ctx, int32_t v, const int32_t *tri, int ccd_only,
+                   self_contact *k)
+{
+    double p0[4][3], p1[4][3], u[4][3];
+    int32_t ids[4] = {v, tri[0], tri[1], tri[2]};
+    for (int j = 0; j < 4; ++j) {
+        load(ctx->x, ctx->y, ctx->z, ids[j], p0[j]);
+        load(ctx->nx, ctx->ny, ctx->nz, ids[j], p1[j]);
+    }
+    /* Tight boxes of this motion: cheap rejection of most candidates. */
+    for (int m = 0; m < 3; ++m) {
+        double plo = min2(p0[0][m], p1[0][m]) - ctx->h, phi = max2(p0[0][m], p1[0][m]) + ctx->h;
+        double tlo = p0[1][m], thi = p0[1][m];
+        for (int j = 1; j < 4; ++j) {
+            tlo = min2(tlo, min2(p0[j][m], p1[j][m]));
+            thi = max2(thi, max2(p0[j][m], p1[j][m]));
+        }
+        if (phi < tlo || plo > thi) return NO_CONTACT;
+    }
+    for (int j = 0; j < 4; ++j)
+        for (int m = 0; m < 3; ++m) u[j][m] = p1[j][m] - p0[j][m];
+    double bary1[3], bary0[3];
+    double d1 = sqrt(wc_point_triangle_closest(p1[0], p1[1], p1[2], p1[3], bary1));
+    double d0 = sqrt(wc_point_triangle_closest(p0[0], p0[1], p0[2], p0[3], bary0));
+    /* The distance changes at most at rate L, so over the step it stays above
+     * (d0 + d1 - L) / 2: when that exceeds the tolerance the cubic cannot
+     * find a collision. */
+    double lip = max_relative_motion(u, 1);
+    k->p[0] = v, k->p[1] = tri[0], k->p[2] = tri[1], k->p[3] = tri[2];
+    if (0.5 * (d0 + d1 - lip) <= ctx->tol) {
+        double t, bary[3];
+        if (wc_ccd_point_triangle(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3],
+                                  ctx->tol, &t, bary)) {
+            k->kind = COLLISION;
+            k->w[0] = 1.0, k->w[1] = -bary[0], k->w[2] = -bary[1], k->w[3] = -bary[2];
+            double a[3], b[3], c[3];
+            lerp3(p0[1], p1[1], t, a), lerp3(p0[2], p1[2], t, b), lerp3(p0[3], p1[3], t, c);
+            wc_triangle_normal(a, b, c, k->n);
+            if (dot3(k->n, k->n) == 0.0) fallback_normal(ctx, k, t);
+            orient(ctx, k);
+            return COLLISION;
+        }
+    }
+    if (ccd_only || !(d1 < ctx->h)) return NO_CONTACT;
+    double r[4][3];
+    for (int j = 0; j < 4; ++j) memcpy(r[j], ctx->rest + 3 * (size_t)ids[j], sizeof r[j]);
+    double bary_rest[3];
+    if (wc_point_triangle_closest(r[0], r[1], r[2], r[3], bary_rest) < ctx->exclude2) return NO_CONTACT;
+    k->kind = PROXIMITY;
+    k->w[0] = 1.0, k->w[1] = -bary1[0], k->w[2] = -bary1[1], k->w[3] = -bary1[2];
+    for (int m = 0; m < 3; ++m)
+        k->n[m] = p1[0][m] - (bary1[0] * p1[1][m] + bary1[1] * p1[2][m] + bary1[2] * p1[3][m]);
+    /* At (nearly) zero distance the direction is noise: use the face normal. */
+    if (!(d1 > 1e-9 * ctx->h) || !normalize3(k->n)) {
+        wc_triangle_normal(p1[1], p1[2], p1[3], k->n);
+        if (dot3(k->n, k->n) == 0.0) fallback_normal(ctx, k, 1.0);
+    }
+    orient(ctx, k);
+    return PROXIMITY;
+}
+
+/* Edge (a, b) against edge (c, d). */
+static int eval_ee(const self_ctx *ctx, const int32_t *e, const int32_t *f, int ccd_only,
+                   self_contact *k)
+{
+    double p0[4][3], p1[4][3], u[4][3];
+    int32_t ids[4] = {e[0], e[1], f[0], f[1]};
+    for (int j = 0; j < 4; ++j) {
+        load(ctx->x, ctx->y, ctx->z, ids[j], p0[j]);
+        load(ctx->nx, ctx->ny, ctx->nz, ids[j], p1[j]);
+    }
+    for (int m = 0; m < 3; ++m) {
+        double alo = min2(min2(p0[0][m], p1[0][m]), min2(p0[1][m], p1[1][m])) - ctx->h;
+        double ahi = max2(max2(p0[0][m], p1[0][m]), max2(p0[1][m], p1[1][m])) + ctx->h;
+        double blo = min2(min2(p0[2][m], p1[2][m]), min2(p0[3][m], p1[3][m]));
+        double bhi = max2(max2(p0[2][m], p1[2][m]), max2(p0[3][m], p1[3][m]));
+        if (ahi < blo || alo > bhi) return NO_CONTACT;
+    }
+    for (int j = 0; j < 4; ++j)
+        for (int m = 0; m < 3; ++m) u[j][m] = p1[j][m] - p0[j][m];
+    double s1, t1, s0, t0;
+    double d1 = sqrt(wc_segment_segment_closest(p1[0], p1[1], p1[2], p1[3], &s1, &t1));
+    double d0 = sqrt(wc_segment_segment_closest(p0[0], p0[1], p0[2], p0[3], &s0, &t0));
+    double lip = max_relative_motion(u, 2);
+    for (int j = 0; j < 4; ++j) k->p[j] = ids[j];
+    if (0.5 * (d0 + d1 - lip) <= ctx->tol) {
+        double t, s, v;
+        if (wc_ccd_edge_edge(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3], ctx->tol,
+                             &t, &s, &v)) {
+            k->kind = COLLISION;
+            k->w[0] = 1.0 - s, k->w[1] = s, k->w[2] = -(1.0 - v), k->w[3] = -v;
+            double a[3], b[3], c[3], d[3], ea[3], eb[3];
+            lerp3(p0[0], p1[0], t, a), lerp3(p0[1], p1[1], t, b);
+            lerp3(p0[2], p1[2], t, c), lerp3(p0[3], p1[3], t, d);
+            for (int m = 0; m < 3; ++m) ea[m] = b[m] - a[m], eb[m] = d[m] - c[m];
+            k->n[0] = ea[1] * eb[2] - ea[2] * eb[1];
+            k->n[1] = ea[2] * eb[0] - ea[0] * eb[2];
+            k->n[2] = ea[0] * eb[1] - ea[1] * eb[0];
+            /* Nearly parallel edges have no reliable cross product. */
+            if (dot3(k->n, k->n) <= 1e-12 * dot3(ea, ea) * dot3(eb, eb) || !normalize3(k->n))
+                fallback_normal(ctx, k, t);
+            orient(ctx, k);
+            return COLLISION;
+        }
+    }
+    if (ccd_only || !(d1 < ctx->h)) return NO_CONTACT;
+    double r[4][3], rs, rt;
+    for (int j = 0; j < 4; ++j) memcpy(r[j], ctx->rest + 3 * (size_t)ids[j], sizeof r[j]);
+    if (wc_segment_segment_closest(r[0], r[1], r[2], r[3], &rs, &rt) < ctx->exclude2) return NO_CONTACT;
+    k->kind = PROXIMITY;
+    k->w[0] = 1.0 - s1, k->w[1] = s1, k->w[2] = -(1.0 - t1), k->w[3] = -t1;
+    for (int m = 0; m < 3; ++m)
+        k->n[m] = (1.0 - s1) * p1[0][m] + s1 * p1[1][m] - (1.0 - t1) * p1[2][m] - t1 * p1[3][m];
+    if (!(d1 > 1e-9 * ctx->h) || !normalize3(k->n)) fallback_normal(ctx, k, 1.0);
+    orient(ctx, k);
+    return PROXIMITY;
+}
+
+static int vf_pair(const wc_self_state *s, const self_ctx *ctx, int64_t i, int ccd_only,
+                   self_contact *k)
+{
+    const int32_t *pr = s->vf + 2 * i;
+    return eval_vf(ctx, pr[0], s->triangles + 3 * (size_t)pr[1], ccd_only, k);
+}
+
+static int ee_pair(const wc_self_state *s, const self_ctx *ctx, int64_t i, int ccd_only,
+                   self_contact *k)
+{
+    const int32_t *pr = s->ee + 2 * i;
+    return eval_ee(ctx, s->edges + 2 * (size_t)pr[0], s->edges + 2 * (size_t)pr[1], ccd_only, k);
+}
+
+/* Re-evaluates, in parallel, every pair with a particle that moved since its
+ * last evaluation; each iteration writes only its own status byte. */
+static void evaluate(wc_self_state *s, const self_ctx *ctx, int ccd_only, int threads)
+{
+    const uint8_t *dirty = s->dirty;
+    int64_t nvf = s->vf_count, nee = s->ee_count;
+#pragma omp parallel for schedule(static) num_threads(threads) if (nvf >= WC_PARALLEL_MIN)
+    for (int64_t i = 0; i < nvf; ++i) {
+        const int32_t *pr = s->vf + 2 * i, *tri = s->triangles + 3 * (size_t)pr[1];
+        if (!(dirty[pr[0]] | dirty[tri[0]] | dirty[tri[1]] | dirty[tri[2]])) continue;
+        self_contact k;
+        s->vf_status[i] = (uint8_t)vf_pair(s, ctx, i, ccd_only, &k);
+    }
+#pragma omp parallel for schedule(static) num_threads(threads) if (nee >= WC_PARALLEL_MIN)
+    for (int64_t i = 0; i < nee; ++i) {
+        const int32_t *pr = s->ee + 2 * i;
+        const int32_t *e = s->edges + 2 * (size_t)pr[0], *f = s->edges + 2 * (size_t)pr[1];
+        if (!(dirty[e[0]] | dirty[e[1]] | dirty[f[0]] | dirty[f[1]])) continue;
+        self_contact k;
+        s->ee_status[i] = (uint8_t)ee_pair(s, ctx, i, ccd_only, &k);
+    }
+    memset(s->dirty, 0, (size_t)s->particle_count);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Response                                                                 */
+/* ------------------------------------------------------------------------ */
+
+/* Answers one contact against the current state: moves nx (and q for the
+ * part that must not become velocity), marks contacts. Returns whether any
+ * particle moved. */
+static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double h, double mu,
+                   int32_t *marked)
+{
+    double im[4], weight = 0.0;
+    if (dot3(k->n, k->n) == 0.0) return 0;
+    for (int j = 0; j < 4; ++j) {
+        int32_t i = k->p[j];
+        if (k->w[j] == 0.0) {
+            im[j] = 0.0;
+            continue;
+        }
+        double side = k->w[j] > 0.0 ? 1.0 : -1.0;
+        if (c->contact[i] == WC_CONTACT_NONE) {
+            c->contact[i] = WC_CONTACT_CLOTH;
+            c->normal_x[i] = side * k->n[0], c->normal_y[i] = side * k->n[1], c->normal_z[i] = side * k->n[2];
+            ++*marked;
+        }
+        im[j] = c->pin_slot[i] >= 0 ? 0.0 : c->inv_mass[i];
+        /* A particle resting on a collider must not be pushed into it: along
+         * that surface's normal it is as good as pinned. */
+        if (c->contact[i] == WC_CONTACT_COLLIDER) {
+            double nc[3] = {c->normal_x[i], c->normal_y[i], c->normal_z[i]};
+            if (side * dot3(k->n, nc) < 0.0) im[j] = 0.0;
+        }
+        weight += k->w[j] * k->w[j] * im[j];
+    }
+    if (!(weight > 0.0)) return 0;
+    double x0[3], x1[3], du[3];
+    relative(c->x, c->y, c->z, k, x0);
+    relative(c->nx, c->ny, c->nz, k, x1);
+    for (int m = 0; m < 3; ++m) du[m] = x1[m] - x0[m];
+    double un = dot3(du, k->n), sep = dot3(x1, k->n);
+    /* Inelastic: the approach along n is removed (dv, a change of velocity),
+     * then the end separation is set to the target (dp, a change of position
+     * only): the pair ends the step at the target, at rest relative to each
+     * other along n. For a collision during the step the target is
+     * min(start separation, h), so a pair never ends closer than it started
+     * unless it stays h apart; a proximity's target is h. dp < 0 means the
+     * pair entered the band this step and settles onto it. */
+    double target = k->kind == COLLISION ? fmin(k->d0, h) : h;
+    double dv = un < 0.0 ? -un : 0.0;
+    double dp = target - (sep + dv);
+    /* A collision whose normal motion already keeps the target cannot be
+     * answered along n (the elements touched at the start): the fail-safe
+     * takes it. */
+    if (k->kind == COLLISION && !(sep < target)) return 0;
+    if (dv == 0.0 && dp <= 0.0) return 0;
+    /* Coulomb friction on the relative tangential motion: its change is at
+     * most mu times the normal change (tangential part of du is unchanged by
+     * the normal impulse). */
+    double ft[3] = {0.0, 0.0, 0.0};
+    if (dv > 0.0 && mu > 0.0) {
+        double vt[3];
+        for (int m = 0; m < 3; ++m) vt[m] = du[m] - un * k->n[m];
+        double len = sqrt(dot3(vt, vt));
+        if (len > 0.0) {
+            double f = mu * dv / len;
+            if (f > 1.0) f = 1.0;
+            for (int m = 0; m < 3; ++m) ft[m] = -f * vt[m];
+        }
+    }
+    for (int j = 0; j < 4; ++j) {
+        double scale = k->w[j] * im[j] / weight;
+        if (scale == 0.0) continue;
+        int32_t i = k->p[j];
+        double move = (dv + dp) * scale;
+        c->nx[i] += move * k->n[0] + scale * ft[0];
+        c->ny[i] += move * k->n[1] + scale * ft[1];
+        c->nz[i] += move * k->n[2] + scale * ft[2];
+        if (dp != 0.0) {
+            /* The position correction is not velocity: shift the previous
+             * position the next step sees by the same amount. */
+            if (!c->history_override[i]) {
+                c->qx[i] = c->x[i], c->qy[i] = c->y[i], c->qz[i] = c->z[i];
+                c->history_override[i] = 1;
+            }
+            double shift = dp * scale;
+            c->qx[i] += shift * k->n[0], c->qy[i] += shift * k->n[1], c->qz[i] += shift * k->n[2];
+        }
+        s->dirty[i] = 1;
+    }
+    return 1;
+}
+
+/* Serial pass over the flagged pairs in candidate order: each is evaluated
+ * again against the current state (earlier responses of the pass may have
+ * answered it already) and answered. Returns whether anything moved. */
+static int respond_all(wc_cloth *c, wc_self_state *s, const self_ctx *ctx, int32_t *marked)
+{
+    double h = ctx->h, mu = c->material.friction;
+    int moved = 0;
+    for (int64_t i = 0; i < s->vf_count; ++i) {
+        if (!s->vf_status[i]) continue;
+        self_contact k;
+        s->vf_status[i] = (uint8_t)vf_pair(s, ctx, i, 0, &k);
+        if (s->vf_status[i]) moved |= respond(c, s, &k, h, mu, marked);
+    }
+    for (int64_t i = 0; i < s->ee_count; ++i) {
+        if (!s->ee_status[i]) continue;
+        self_contact k;
+        s->ee_status[i] = (uint8_t)ee_pair(s, ctx, i, 0, &k);
+        if (s->ee_status[i]) moved |= respond(c, s, &k, h, mu, marked);
+    }
+    return moved;
+}
+
+/* Whether the candidates still hold every pair that can touch after some
+ * particles moved (those marked dirty): each inside its box, and every
+ * culling decision that involves a patch holding one of them still true
+ * for the new motion. */
+static int still_valid(wc_self_state *s, const wc_cloth *c)
+{
+    for (int32_t i = 0; i < s->particle_count; ++i) {
+        if (!s->dirty[i]) continue;
+        const double *b = s->particle_boxes + 6 * (size_t)i;
+        if (c->nx[i] < b[0] || c->nx[i] > b[3] || c->ny[i] < b[1] || c->ny[i] > b[4] ||
+            c->nz[i] < b[2] || c->nz[i] > b[5])
+            return 0;
+    }
+    const csr *pp = &s->patch_particles, *adj = &s->patch_adjacent;
+    int any = 0;
+    for (int32_t p = 0; p < s->patch_count; ++p) {
+        uint8_t touched = 0;
+        for (int32_t k = pp->start[p]; k < pp->start[p + 1] && !touched; ++k) touched = s->dirty[pp->items[k]];
+        s->patch_touched[p] = touched;
+        if (!touched) continue;
+        any = 1;
+        for (int32_t k = s->patch_triangles.start[p]; k < s->patch_triangles.start[p + 1]; ++k) {
+            int32_t t = s->patch_triangles.items[k];
+            triangle_normal_motion(c, s->triangles + 3 * (size_t)t, s->triangle_normals + 9 * (size_t)t);
+        }
+        patch_cone(s, p);
+    }
+    if (!any) return 1;
+    for (int32_t p = 0; p < s->patch_count; ++p) {
+        if (!s->patch_touched[p]) continue;
+        if (s->patch_culled[p] && !(s->patch_cos[p] > CONE_COS)) return 0;
+        for (int32_t k = adj->start[p]; k < adj->start[p + 1]; ++k)
+            if (s->adjacent_culled[k] && !cones_join(s, p, adj->items[k])) return 0;
+    }
+    return 1;
+}
+
+/* Puts a particle back where the step started, at rest. */
+static void revert(wc_cloth *c, wc_self_state *s, int32_t i)
+{
+    c->nx[i] = c->x[i], c->ny[i] = c->y[i], c->nz[i] = c->z[i];
+    c->qx[i] = c->x[i], c->qy[i] = c->y[i], c->qz[i] = c->z[i];
+    c->history_override[i] = 1;
+    s->reverted[i] = 1;
+    s->dirty[i] = 1;
+}
+
+/* Reverts every free particle of every pair whose motion still collides,
+ * then detects again, until nothing collides or nothing is left to revert
+ * (only pinned or already reverted particles in the colliding pairs: a pin
+ * driven into the cloth). The set reverted is the union of the impact zones
+ * (the connected groups of colliding pairs); since every member goes back,
+ * the zones need not be formed explicitly. Reverting keeps particles inside
+ * their boxes but changes the motion of their triangles, so the culling is
+ * checked again each round. */
+static wc_status failsafe(wc_cloth *c, wc_self_state *s, self_ctx *ctx, double g, int threads,
+                          int32_t *count)
+{
+    int32_t total = 0;
+    memset(s->reverted, 0, (size_t)s->particle_count);
+    for (;;) {
+        int32_t newly = 0;
+        for (int64_t i = 0; i < s->vf_count; ++i) {
+            if (s->vf_status[i] != COLLISION) continue;
+            const int32_t *pr = s->vf + 2 * i, *tri = s->triangles + 3 * (size_t)pr[1];
+            int32_t ids[4] = {pr[0], tri[0], tri[1], tri[2]};
+            for (int j = 0; j < 4; ++j)
+                if (!s->reverted[ids[j]] && c->pin_slot[ids[j]] < 0) revert(c, s, ids[j]), ++newly;
+        }
+        for (int64_t i = 0; i < s->ee_count; ++i) {
+            if (s->ee_status[i] != COLLISION) continue;
+            const int32_t *pr = s->ee + 2 * i;
+            const int32_t *e = s->edges + 2 * (size_t)pr[0], *f = s->edges + 2 * (size_t)pr[1];
+            int32_t ids[4] = {e[0], e[1], f[0], f[1]};
+            for (int j = 0; j < 4; ++j)
+                if (!s->reverted[ids[j]] && c->pin_slot[ids[j]] < 0) revert(c, s, ids[j]), ++newly;
+        }
+        if (!newly) break;
+        total += newly;
+        if (!still_valid(s, c)) {
+            if (broadphase(s, c, ctx->h, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+            memset(s->dirty, 1, (size_t)s->particle_count);
+        }
+        evaluate(s, ctx, 1, threads);
+    }
+    *count = total;
+    return WC_OK;
+}
+
+#ifdef WC_SELF_PROFILE
+#include <stdio.h>
+static long prof_calls, prof_open, prof_vf, prof_ee, prof_passes, prof_rebuilds, prof_np, prof_culled;
+static void prof_report(void)
+{
+    if (prof_calls)
+        fprintf(stderr, "self: %ld calls; per call: patches %.0f culled %.0f open %.1f vf %.1f ee %.1f passes %.2f rebuilds %.3f\n",
+                prof_calls, (double)prof_np / prof_calls, (double)prof_culled / prof_calls, (double)prof_open / prof_calls,
+                (double)prof_vf / prof_calls, (double)prof_ee / prof_calls, (double)prof_passes / prof_calls,
+                (double)prof_rebuilds / prof_calls);
+}
+#endif
+
+wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *stats)
+{
+    (void)dt; /* everything works in displacements over the step */
+    wc_self_state *s = c->self;
+    if (!s || s->triangle_count == 0) return WC_OK;
+    if (threads < 1) threads = 1;
+    self_ctx ctx;
+    ctx.h = max2(c->material.thickness, MIN_THICKNESS * s->mean_edge);
+    ctx.tol = CCD_TOLERANCE * ctx.h;
+    ctx.exclude2 = (REST_EXCLUSION * ctx.h) * (REST_EXCLUSION * ctx.h);
+    ctx.rest = s->rest;
+    /* nx/ny/nz are the cloth's current arrays (they swap at commit). */
+    ctx.x = c->x, ctx.y = c->y, ctx.z = c->z, ctx.nx = c->nx, ctx.ny = c->ny, ctx.nz = c->nz;
+    double g = BOX_MARGIN * ctx.h;
+    int32_t marked = 0, reverted = 0;
+    int rebuild = 1;
+    for (int pass = 0;; ++pass) {
+        if (rebuild) {
+            if (broadphase(s, c, ctx.h, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+            memset(s->dirty, 1, (size_t)s->particle_count);
+        }
+        int last = pass >= SELF_PASSES;
+#ifdef WC_SELF_PROFILE
+        if (!prof_calls++) atexit(prof_report);
+        prof_passes++;
+        if (rebuild) {
+            prof_rebuilds++, prof_open += s->open_count, prof_vf += s->vf_count, prof_ee += s->ee_count, prof_np += s->patch_count;
+            for (int32_t p = 0; p < s->patch_count; ++p) prof_culled += s->patch_culled[p];
+        }
+        if (pass) prof_calls--;
+#endif
+        evaluate(s, &ctx, last, threads);
+        if (last || !respond_all(c, s, &ctx, &marked)) break;
+        rebuild = !still_valid(s, c);
+    }
+    if (failsafe(c, s, &ctx, g, threads, &reverted)) return WC_ERROR_OUT_OF_MEMORY;
+    if (stats) {
+        stats->cloth_contacts += marked;
+        stats->failsafe_particles += reverted;
+    }
+    return WC_OK;
+}

@@ -1,0 +1,27 @@
+/* Self-collision of one cloth over one step (SPEC 2): vertex-face and
+ * edge-edge proximity within the cloth's thickness, continuous detection of
+ * the step's motion, an inelastic response with friction, and a fail-safe
+ * that puts particles back where they were at the start of the step (an
+ * intersection-free state) until no intersection is left. */
+#ifndef WC_SELFCOLLIDE_H
+#define WC_SELFCOLLIDE_H
+
+#include "cloth.h"
+
+/// Per-cloth buffers (broadphase grid, edge list, scratch). Opaque.
+typedef struct wc_self_state wc_self_state;
+
+/// Allocates the state for a cloth (its topology must be built). NULL on
+/// out-of-memory.
+wc_self_state *wc_self_state_create(const wc_cloth *cloth);
+void wc_self_state_destroy(wc_self_state *state);
+
+/// Resolves self-collisions of the motion from (x, y, z) to (nx, ny, nz):
+/// moves nx/ny/nz, sets the history override (qx/qy/qz, history_override)
+/// where it changes velocities through the previous position, and marks
+/// contacts (contact = WC_CONTACT_CLOTH, normal). Pinned particles do not
+/// move. Adds to stats->cloth_contacts and stats->failsafe_particles.
+/// Deterministic for any thread count.
+wc_status wc_self_collide(wc_cloth *cloth, double dt, int threads, wc_step_stats *stats);
+
+#endif

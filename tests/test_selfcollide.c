@@ -1,0 +1,421 @@
+/* Self-collision (libwetcloth/selfcollide.c, SPEC 2):
+ *  (a) a vertex thrown through a face in one step is stopped on its own side,
+ *      at least the thickness away;
+ *  (b) two edges thrown across each other are stopped likewise;
+ *  (c) the fail-safe: a stack of layers all thrown through one another, which
+ *      the response passes cannot sort out, ends with no collision left in
+ *      the step's motion; reverted particles are exactly at their start, at
+ *      rest;
+ *  (d) the same crumpled cloth resolved on 1, 2 and 4 threads gives the same
+ *      bits.
+ * These drive wc_self_collide directly on a cloth's internal arrays, with a
+ * brute-force check (every vertex-face and edge-edge pair, no broadphase)
+ * of what remains. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cloth.h"
+#include "primitives.h"
+#include "selfcollide.h"
+#include "test_util.h"
+#include "wetcloth.h"
+#include "world.h"
+
+static uint64_t rng = 0x2545F4914F6CDD1Dull;
+static double uniform(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (double)(rng >> 11) / 9007199254740992.0;
+}
+
+static wc_world *new_world(int threads)
+{
+    wc_world_def wd = wc_world_def_default();
+    wd.thread_count = threads;
+    wc_world *w = NULL;
+    wc_message m;
+    wc_status s = wc_world_create(&wd, &w, &m);
+    CHECK(s == WC_OK, "world: %s", m.text);
+    return w;
+}
+
+/* A mesh cloth with self-collision; returns its internal struct. */
+static wc_cloth *add_mesh(wc_world *w, const double *xyz, int32_t n, const int32_t *faces,
+                          int32_t face_count, double thickness)
+{
+    wc_mesh_cloth_def d = wc_mesh_cloth_def_default();
+    d.vertices = xyz;
+    d.vertex_count = n;
+    d.faces = faces;
+    d.face_count = face_count;
+    d.face_size = 3;
+    d.material.thickness = thickness;
+    d.self_collision = 1;
+    int32_t id;
+    wc_status s = wc_world_add_mesh_cloth(w, &d, &id);
+    CHECK(s == WC_OK, "add_mesh_cloth: %s", wc_world_last_error(w));
+    return s == WC_OK ? w->cloths[id] : NULL;
+}
+
+static void clear_contacts(wc_cloth *c)
+{
+    memset(c->contact, 0, (size_t)c->particle_count);
+    memset(c->history_override, 0, (size_t)c->particle_count);
+}
+
+static void get(const double *x, const double *y, const double *z, int32_t i, double out[3])
+{
+    out[0] = x[i], out[1] = y[i], out[2] = z[i];
+}
+
+static void set_end(wc_cloth *c, int32_t i, double x, double y, double z)
+{
+    c->nx[i] = x, c->ny[i] = y, c->nz[i] = z;
+}
+
+/* Unique edges of the cloth's triangles, brute force (small meshes). */
+static int32_t collect_edges(const wc_cloth *c, int32_t *edges)
+{
+    int32_t count = 0;
+    for (int32_t t = 0; t < c->topology.triangle_count; ++t)
+        for (int k = 0; k < 3; ++k) {
+            int32_t a = c->topology.triangles[3 * t + k], b = c->topology.triangles[3 * t + (k + 1) % 3];
+            if (a > b) {
+                int32_t tmp = a;
+                a = b, b = tmp;
+            }
+            int found = 0;
+            for (int32_t e = 0; e < count && !found; ++e) found = edges[2 * e] == a && edges[2 * e + 1] == b;
+            if (!found) edges[2 * count] = a, edges[2 * count + 1] = b, ++count;
+        }
+    return count;
+}
+
+/* Every vertex-face and edge-edge pair whose motion x -> nx collides
+ * (coplanar within tol). No broadphase: checks the solver's. */
+static int32_t count_ccd_collisions(const wc_cloth *c, double tol)
+{
+    int32_t hits = 0, nt = c->topology.triangle_count;
+    const int32_t *tris = c->topology.triangles;
+    for (int32_t t = 0; t < nt; ++t) {
+        double a0[3], a1[3], b0[3], b1[3], c0[3], c1[3];
+        const int32_t *tri = tris + 3 * t;
+        get(c->x, c->y, c->z, tri[0], a0), get(c->nx, c->ny, c->nz, tri[0], a1);
+        get(c->x, c->y, c->z, tri[1], b0), get(c->nx, c->ny, c->nz, tri[1], b1);
+        get(c->x, c->y, c->z, tri[2], c0), get(c->nx, c->ny, c->nz, tri[2], c1);
+        for (int32_t v = 0; v < c->particle_count; ++v) {
+            if (v == tri[0] || v == tri[1] || v == tri[2]) continue;
+            double p0[3], p1[3], time, bary[3];
+            get(c->x, c->y, c->z, v, p0), get(c->nx, c->ny, c->nz, v, p1);
+            hits += wc_ccd_point_triangle(p0, p1, a0, a1, b0, b1, c0, c1, tol, &time, bary);
+        }
+    }
+    int32_t *edges = malloc(sizeof(int32_t) * 6 * (size_t)nt);
+    int32_t ne = collect_edges(c, edges);
+    for (int32_t e = 0; e < ne; ++e)
+        for (int32_t f = e + 1; f < ne; ++f) {
+            const int32_t *E = edges + 2 * e, *F = edges + 2 * f;
+            if (E[0] == F[0] || E[0] == F[1] || E[1] == F[0] || E[1] == F[1]) continue;
+            double p[4][2][3], time, s, u;
+            int32_t ids[4] = {E[0], E[1], F[0], F[1]};
+            for (int j = 0; j < 4; ++j) {
+                get(c->x, c->y, c->z, ids[j], p[j][0]);
+                get(c->nx, c->ny, c->nz, ids[j], p[j][1]);
+            }
+            hits += wc_ccd_edge_edge(p[0][0], p[0][1], p[1][0], p[1][1], p[2][0], p[2][1], p[3][0],
+                                     p[3][1], tol, &time, &s, &u);
+        }
+    free(edges);
+    return hits;
+}
+
+/* ------------------------------------------------------------------------ */
+/* (a) vertex through a face                                                */
+/* ------------------------------------------------------------------------ */
+
+static void test_vertex_face(void)
+{
+    const double h = 0.01;
+    /* Triangle A flat at z = 0; triangle B above, its apex (vertex 3)
+     * pointing down at z = 0.05 over A's interior. */
+    double xyz[] = {-0.5, -0.5, 0.0, 0.5, -0.5, 0.0, 0.0, 0.5, 0.0,
+                    0.0,  0.0,  0.05, 0.3, 0.1, 0.4, -0.3, 0.1, 0.4};
+    int32_t faces[] = {0, 1, 2, 3, 4, 5};
+    wc_world *w = new_world(1);
+    wc_cloth *c = add_mesh(w, xyz, 6, faces, 2, h);
+    if (!c) return;
+    /* Apex thrown 0.2 m down through A in one step; the rest of B follows a
+     * little; A is still. */
+    for (int32_t i = 0; i < 6; ++i) set_end(c, i, c->x[i], c->y[i], c->z[i]);
+    set_end(c, 3, 0.0, 0.0, -0.15);
+    set_end(c, 4, 0.3, 0.1, 0.35);
+    set_end(c, 5, -0.3, 0.1, 0.35);
+    clear_contacts(c);
+    CHECK(count_ccd_collisions(c, 1e-9) > 0, "setup: the apex should pass through A");
+    wc_step_stats stats = {0, 0, 0};
+    wc_status s = wc_self_collide(c, 0.01, 1, &stats);
+    CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
+    double p[3], a[3], b[3], q[3], bary[3];
+    get(c->nx, c->ny, c->nz, 3, p);
+    get(c->nx, c->ny, c->nz, 0, a);
+    get(c->nx, c->ny, c->nz, 1, b);
+    get(c->nx, c->ny, c->nz, 2, q);
+    double d = sqrt(wc_point_triangle_closest(p, a, b, q, bary));
+    double plane = p[2] - (bary[0] * a[2] + bary[1] * b[2] + bary[2] * q[2]);
+    printf("vertex-face: apex ends %.6g m above A (thickness %g), contacts %d, fail-safe %d\n",
+           plane, h, (int)stats.cloth_contacts, (int)stats.failsafe_particles);
+    CHECK(plane > 0.0, "the apex ended below A: %g", plane);
+    CHECK(d >= 0.999 * h, "the apex ended %g from A, closer than the thickness %g", d, h);
+    CHECK(count_ccd_collisions(c, 1e-9) == 0, "a collision remains");
+    CHECK(stats.failsafe_particles == 0, "needed the fail-safe (%d)", (int)stats.failsafe_particles);
+    CHECK(stats.cloth_contacts >= 4, "contacts: %d", (int)stats.cloth_contacts);
+    CHECK(c->contact[3] == WC_CONTACT_CLOTH && c->normal_z[3] > 0.99,
+          "apex contact %d normal z %g", (int)c->contact[3], c->normal_z[3]);
+    CHECK(c->contact[0] == WC_CONTACT_CLOTH && c->normal_z[0] < -0.99,
+          "face contact %d normal z %g", (int)c->contact[0], c->normal_z[0]);
+    /* Momentum: equal and opposite displacement changes (inelastic). */
+    double before = c->mass[3] * (-0.2), after = 0.0;
+    for (int32_t i = 0; i < 6; ++i)
+        if (i != 4 && i != 5) after += c->mass[i] * (c->nz[i] - c->z[i]);
+    CHECK(fabs(after - before) < 1e-12, "vertical momentum changed: %g -> %g", before, after);
+    wc_world_destroy(w);
+}
+
+/* ------------------------------------------------------------------------ */
+/* (b) edge through an edge                                                 */
+/* ------------------------------------------------------------------------ */
+
+static void test_edge_edge(void)
+{
+    const double h = 0.01;
+    /* A: vertical triangle in the plane y = 0, top edge along x at z = 0.
+     * B: vertical triangle in the plane x = 0 (apex slightly off it), bottom
+     * edge along y at z = 0.05, right above A's top edge. B drops 0.2 m: its
+     * bottom edge crosses A's top edge, and no vertex goes through a face. */
+    double xyz[] = {-0.5, 0.0, 0.0,  0.5, 0.0, 0.0,  0.0,  0.0, -0.5,
+                    0.0, -0.2, 0.05, 0.0, 0.2, 0.05, 0.02, 0.0, 0.4};
+    int32_t faces[] = {0, 1, 2, 3, 4, 5};
+    wc_world *w = new_world(1);
+    wc_cloth *c = add_mesh(w, xyz, 6, faces, 2, h);
+    if (!c) return;
+    for (int32_t i = 0; i < 6; ++i) set_end(c, i, c->x[i], c->y[i], c->z[i] - (i >= 3 ? 0.2 : 0.0));
+    clear_contacts(c);
+    CHECK(count_ccd_collisions(c, 1e-9) > 0, "setup: the edges should cross");
+    wc_step_stats stats = {0, 0, 0};
+    wc_status s = wc_self_collide(c, 0.01, 1, &stats);
+    CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
+    double p0[3], p1[3], q0[3], q1[3], u, v;
+    get(c->nx, c->ny, c->nz, 0, p0);
+    get(c->nx, c->ny, c->nz, 1, p1);
+    get(c->nx, c->ny, c->nz, 3, q0);
+    get(c->nx, c->ny, c->nz, 4, q1);
+    double d = sqrt(wc_segment_segment_closest(p0, p1, q0, q1, &u, &v));
+    double gap = (q0[2] + (q1[2] - q0[2]) * v) - (p0[2] + (p1[2] - p0[2]) * u);
+    printf("edge-edge: B's edge ends %.6g m above A's (thickness %g), contacts %d, fail-safe %d\n",
+           gap, h, (int)stats.cloth_contacts, (int)stats.failsafe_particles);
+    CHECK(gap > 0.0, "B's edge ended below A's: %g", gap);
+    CHECK(d >= 0.999 * h, "edges end %g apart, closer than the thickness %g", d, h);
+    CHECK(count_ccd_collisions(c, 1e-9) == 0, "a collision remains");
+    CHECK(stats.failsafe_particles == 0, "needed the fail-safe (%d)", (int)stats.failsafe_particles);
+    wc_world_destroy(w);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Pinned particles                                                         */
+/* ------------------------------------------------------------------------ */
+
+/* A vertex thrown through a face whose corners are all pinned: the face does
+ * not move, the vertex takes the whole response. */
+static void test_pinned_face(void)
+{
+    const double h = 0.01;
+    double xyz[] = {-0.5, -0.5, 0.0, 0.5, -0.5, 0.0, 0.0, 0.5, 0.0,
+                    0.0,  0.0,  0.05, 0.3, 0.1, 0.4, -0.3, 0.1, 0.4};
+    int32_t faces[] = {0, 1, 2, 3, 4, 5};
+    wc_world *w = new_world(1);
+    wc_cloth *c = add_mesh(w, xyz, 6, faces, 2, h);
+    if (!c) return;
+    int32_t pins[3] = {0, 1, 2};
+    wc_status ps = wc_cloth_pin(w, 0, pins, 3);
+    CHECK(ps == WC_OK, "pin: %s", wc_world_last_error(w));
+    for (int32_t i = 0; i < 6; ++i) set_end(c, i, c->x[i], c->y[i], c->z[i]);
+    set_end(c, 3, 0.0, 0.0, -0.15);
+    clear_contacts(c);
+    wc_step_stats stats = {0, 0, 0};
+    wc_self_collide(c, 0.01, 1, &stats);
+    for (int32_t i = 0; i < 3; ++i)
+        CHECK(c->nx[i] == c->x[i] && c->ny[i] == c->y[i] && c->nz[i] == c->z[i],
+              "pinned particle %d moved", (int)i);
+    CHECK(c->nz[3] >= 0.999 * h, "the apex ends at z = %g, below the thickness %g", c->nz[3], h);
+    CHECK(count_ccd_collisions(c, 1e-9) == 0, "a collision remains");
+    wc_world_destroy(w);
+}
+
+/* ------------------------------------------------------------------------ */
+/* (c) the fail-safe                                                        */
+/* ------------------------------------------------------------------------ */
+
+/* `layers` square patches of k x k particles, stacked `gap` apart. */
+static wc_cloth *add_stack(wc_world *w, int layers, int k, double gap, double h)
+{
+    int32_t n = layers * k * k, nf = layers * 2 * (k - 1) * (k - 1);
+    double *xyz = malloc(sizeof(double) * 3 * (size_t)n);
+    int32_t *faces = malloc(sizeof(int32_t) * 3 * (size_t)nf);
+    int32_t f = 0;
+    for (int l = 0; l < layers; ++l) {
+        int32_t base = l * k * k;
+        for (int j = 0; j < k; ++j)
+            for (int i = 0; i < k; ++i) {
+                double *p = xyz + 3 * (size_t)(base + j * k + i);
+                /* each layer slightly shifted and tilted: no coplanar
+                 * degeneracies between layers */
+                p[0] = 0.1 * i + 0.013 * l;
+                p[1] = 0.1 * j - 0.007 * l;
+                p[2] = gap * l + 0.002 * i - 0.001 * j;
+            }
+        for (int j = 0; j + 1 < k; ++j)
+            for (int i = 0; i + 1 < k; ++i) {
+                int32_t a = base + j * k + i, b = a + 1, c = a + k, d = c + 1;
+                int32_t *t = faces + 3 * (size_t)f;
+                t[0] = a, t[1] = b, t[2] = d, t[3] = a, t[4] = d, t[5] = c;
+                f += 2;
+            }
+    }
+    wc_cloth *c = add_mesh(w, xyz, n, faces, nf, h);
+    free(xyz);
+    free(faces);
+    return c;
+}
+
+static void test_failsafe(void)
+{
+    const int layers = 10, k = 5;
+    const double gap = 0.03, h = 0.005;
+    wc_world *w = new_world(1);
+    wc_cloth *c = add_stack(w, layers, k, gap, h);
+    if (!c) return;
+    /* Every layer is thrown through all the others (the order of the stack
+     * reverses) and every particle gets a random kick of several layer gaps
+     * on top: a tangle that a few response passes cannot sort out. Every
+     * particle moves. */
+    rng = 12345;
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        int l = i / (k * k);
+        double dz = -2.0 * gap * l + gap * (layers - 1);
+        set_end(c, i, c->x[i] + 0.6 * (uniform() - 0.5), c->y[i] + 0.6 * (uniform() - 0.5),
+                c->z[i] + dz + 0.6 * (uniform() - 0.5));
+    }
+    clear_contacts(c);
+    int32_t before = count_ccd_collisions(c, 1e-9);
+    wc_step_stats stats = {0, 0, 0};
+    wc_status s = wc_self_collide(c, 0.01, 1, &stats);
+    CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
+    int32_t after = count_ccd_collisions(c, 1e-9);
+    int32_t at_start = 0, bad_history = 0;
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        if (c->nx[i] != c->x[i] || c->ny[i] != c->y[i] || c->nz[i] != c->z[i]) continue;
+        ++at_start;
+        /* at rest: the previous position the next step sees is the start */
+        if (!c->history_override[i] || c->qx[i] != c->x[i] || c->qy[i] != c->y[i] || c->qz[i] != c->z[i])
+            ++bad_history;
+    }
+    printf("fail-safe: %d colliding pairs in the thrown motion, %d after; %d of %d particles "
+           "reverted (%d at their start), contacts %d\n",
+           (int)before, (int)after, (int)stats.failsafe_particles, (int)c->particle_count,
+           (int)at_start, (int)stats.cloth_contacts);
+    CHECK(before > 50, "setup: only %d collisions", (int)before);
+    CHECK(after == 0, "%d collisions remain", (int)after);
+    CHECK(stats.failsafe_particles > 0, "the fail-safe did not run");
+    CHECK(at_start >= stats.failsafe_particles, "%d reverted but only %d at their start",
+          (int)stats.failsafe_particles, (int)at_start);
+    CHECK(bad_history == 0, "%d reverted particles not at rest", (int)bad_history);
+    wc_world_destroy(w);
+}
+
+/* ------------------------------------------------------------------------ */
+/* (d) determinism across thread counts                                     */
+/* ------------------------------------------------------------------------ */
+
+/* A size x size grid crumpled in its plane (shrunk to 40 %) with folds and
+ * noise out of it, thrown with random velocities: thousands of contacts. */
+static wc_world *crumpled(int size, int threads, double thickness)
+{
+    wc_world *w = new_world(threads);
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = size;
+    g.material.thickness = thickness;
+    g.self_collision = 1;
+    int32_t id;
+    wc_status s = wc_world_add_grid_cloth(w, &g, &id);
+    CHECK(s == WC_OK, "add_grid_cloth: %s", wc_world_last_error(w));
+    wc_cloth *c = w->cloths[id];
+    double edge = 1.0 / (size - 1);
+    rng = 777;
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        double u = c->x[i], v = c->y[i];
+        c->x[i] = 0.4 * u;
+        c->y[i] = 0.4 * v;
+        c->z[i] = 0.03 * sin(40.0 * u) * cos(23.0 * v) + 0.3 * edge * (uniform() - 0.5);
+        set_end(c, i, c->x[i] + 0.5 * edge * (uniform() - 0.5), c->y[i] + 0.5 * edge * (uniform() - 0.5),
+                c->z[i] + 2.0 * edge * (uniform() - 0.5));
+    }
+    clear_contacts(c);
+    return w;
+}
+
+static void test_threads(void)
+{
+    const int size = 80; /* 6400 particles: above WC_PARALLEL_MIN */
+    double *ref = NULL;
+    size_t n = 0;
+    wc_step_stats ref_stats = {0, 0, 0};
+    int thread_counts[3] = {1, 2, 4};
+    for (int r = 0; r < 3; ++r) {
+        wc_world *w = crumpled(size, thread_counts[r], 0.004);
+        wc_cloth *c = w->cloths[0];
+        n = (size_t)c->particle_count;
+        wc_step_stats stats = {0, 0, 0};
+        wc_status s = wc_self_collide(c, 0.001, thread_counts[r], &stats);
+        CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
+        /* Everything the call writes, as bits. */
+        double *out = malloc(sizeof(double) * 11 * n);
+        const double *arrays[9] = {c->nx, c->ny, c->nz, c->qx, c->qy, c->qz, c->normal_x, c->normal_y, c->normal_z};
+        for (int a = 0; a < 9; ++a) memcpy(out + a * n, arrays[a], n * sizeof(double));
+        for (size_t i = 0; i < n; ++i) {
+            /* q is only meaningful where overridden */
+            if (!c->history_override[i]) out[3 * n + i] = out[4 * n + i] = out[5 * n + i] = 0.0;
+            out[9 * n + i] = c->contact[i];
+            out[10 * n + i] = c->history_override[i];
+        }
+        if (r == 0) {
+            ref = out;
+            ref_stats = stats;
+            printf("threads: crumpled %dx%d cloth: %d contacts, %d reverted\n", size, size,
+                   (int)stats.cloth_contacts, (int)stats.failsafe_particles);
+            CHECK(stats.cloth_contacts > 1000, "only %d contacts", (int)stats.cloth_contacts);
+        } else {
+            CHECK(memcmp(out, ref, sizeof(double) * 11 * n) == 0, "%d threads differ from 1",
+                  thread_counts[r]);
+            CHECK(stats.cloth_contacts == ref_stats.cloth_contacts &&
+                      stats.failsafe_particles == ref_stats.failsafe_particles,
+                  "%d threads: stats differ", thread_counts[r]);
+            free(out);
+        }
+        wc_world_destroy(w);
+    }
+    free(ref);
+}
+
+int main(void)
+{
+    test_vertex_face();
+    test_edge_edge();
+    test_pinned_face();
+    test_failsafe();
+    test_threads();
+    return test_report("test_selfcollide");
+}

@@ -1,0 +1,136 @@
+/* Collision benchmark: the thesis' Table 3.2 scene and self-collision
+ * scaling, each figure measured in this run.
+ *
+ *   build/tools/bench_collide [threads=1] [seconds=1.0]
+ *
+ * Table 3.2 scene: an n x n grid cloth, 1 m wide, 0.6 m above the 114-vertex
+ * UV sphere (16 segments x 8 rings, radius 0.3 m), falling onto it. Each
+ * configuration runs for `seconds` of simulated time in frames of 1/24 s
+ * with automatic substeps; steps per second = substeps taken / wall time.
+ * The thesis drew one frame per step, so its fps compares with our
+ * steps per second.
+ *
+ * Self-collision scaling: n x n cloths dropped onto the sphere with
+ * self-collision on; particle-steps per second. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "wetcloth.h"
+
+#define PI 3.14159265358979323846
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void check(wc_status s, const wc_world *w, const char *what)
+{
+    if (s == WC_OK) return;
+    fprintf(stderr, "%s failed: %s: %s\n", what, wc_status_name(s), w ? wc_world_last_error(w) : "");
+    exit(1);
+}
+
+static void add_sphere(wc_world *w)
+{
+    double v[3 * 114];
+    int32_t t[3 * 224], n = 0, k = 0, seg = 16, rings = 8, col;
+    v[0] = v[1] = 0.0, v[2] = 0.3, n = 1;
+    for (int32_t j = 1; j < rings; ++j)
+        for (int32_t i = 0; i < seg; ++i, ++n) {
+            double polar = PI * j / rings, az = 2.0 * PI * i / seg;
+            v[3 * n] = 0.3 * sin(polar) * cos(az);
+            v[3 * n + 1] = 0.3 * sin(polar) * sin(az);
+            v[3 * n + 2] = 0.3 * cos(polar);
+        }
+    v[3 * n] = v[3 * n + 1] = 0.0, v[3 * n + 2] = -0.3;
+    int32_t bottom = n++, base = 1 + (rings - 2) * seg;
+    for (int32_t i = 0; i < seg; ++i) t[k++] = 0, t[k++] = 1 + i, t[k++] = 1 + (i + 1) % seg;
+    for (int32_t j = 0; j + 2 < rings; ++j)
+        for (int32_t i = 0; i < seg; ++i) {
+            int32_t a = 1 + j * seg + i, b = 1 + j * seg + (i + 1) % seg;
+            t[k++] = a, t[k++] = a + seg, t[k++] = b;
+            t[k++] = b, t[k++] = a + seg, t[k++] = b + seg;
+        }
+    for (int32_t i = 0; i < seg; ++i) t[k++] = bottom, t[k++] = base + (i + 1) % seg, t[k++] = base + i;
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertices = v, d.vertex_count = n, d.triangles = t, d.triangle_count = k / 3;
+    check(wc_world_add_mesh_collider(w, &d, &col), w, "add sphere");
+}
+
+typedef struct result {
+    double steps_per_second;
+    double particle_steps_per_second;
+    int64_t steps;
+    int32_t intersections;
+} result;
+
+static result run(int size, int self_collision, int threads, double seconds)
+{
+    wc_world_def wd = wc_world_def_default();
+    wd.thread_count = threads;
+    wc_world *w;
+    wc_message m;
+    check(wc_world_create(&wd, &w, &m), NULL, m.text);
+    add_sphere(w);
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = size;
+    g.center[2] = 0.6;
+    g.self_collision = self_collision;
+    int32_t c;
+    check(wc_world_add_grid_cloth(w, &g, &c), w, "add cloth");
+    int frames = (int)ceil(seconds * 24.0);
+    result r = {0, 0, 0, 0};
+    double t0 = now();
+    for (int f = 0; f < frames; ++f) {
+        check(wc_world_advance(w, 1.0 / 24.0, 0), w, "advance");
+        r.steps += wc_world_last_substeps(w);
+    }
+    double wall = now() - t0;
+    wc_intersection_counts counts;
+    check(wc_world_count_intersections(w, &counts), w, "count_intersections");
+    r.intersections = counts.cloth_cloth + counts.cloth_collider;
+    r.steps_per_second = (double)r.steps / wall;
+    r.particle_steps_per_second = r.steps_per_second * size * size;
+    wc_world_destroy(w);
+    return r;
+}
+
+int main(int argc, char **argv)
+{
+    int threads = argc > 1 ? atoi(argv[1]) : 1;
+    double seconds = argc > 2 ? atof(argv[2]) : 1.0;
+    if (threads < 1 || !(seconds > 0.0)) {
+        fprintf(stderr, "usage: bench_collide [threads>=1] [seconds>0]\n");
+        return 2;
+    }
+    static const int sizes[3] = {10, 15, 20};
+    static const int thesis_on[3] = {62, 15, 6}, thesis_off[3] = {142, 62, 35};
+    printf("libwetcloth %s collision benchmark, %d thread(s), %.2f simulated s per run\n\n",
+           wc_version_string(), threads, seconds);
+    printf("Thesis Table 3.2 scene (grid cloth onto the 114-vertex sphere):\n\n");
+    printf("| particles | self-collision | steps/s | thesis fps | ratio | intersections at end |\n");
+    printf("|---|---|---|---|---|---|\n");
+    for (int i = 0; i < 3; ++i)
+        for (int self = 1; self >= 0; --self) {
+            result r = run(sizes[i], self, threads, seconds);
+            int thesis = self ? thesis_on[i] : thesis_off[i];
+            printf("| %d | %s | %.0f | %d | %.0fx | %d |\n", sizes[i] * sizes[i], self ? "on" : "off",
+                   r.steps_per_second, thesis, r.steps_per_second / thesis, (int)r.intersections);
+        }
+    printf("\nSelf-collision on, larger cloths (same scene):\n\n");
+    printf("| particles | particle-steps/s | steps/s | intersections at end |\n|---|---|---|---|\n");
+    static const int big[3] = {64, 128, 256};
+    for (int i = 0; i < 3; ++i) {
+        result r = run(big[i], 1, threads, i == 2 ? seconds / 8 : seconds / 2);
+        printf("| %d | %.2f M | %.0f | %d |\n", big[i] * big[i], r.particle_steps_per_second / 1e6,
+               r.steps_per_second, (int)r.intersections);
+    }
+    return 0;
+}
