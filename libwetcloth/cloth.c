@@ -5,6 +5,7 @@
 
 #include "alloc.h"
 #include "buckling.h"
+#include "collide_features.h"
 #include "selfcollide.h"
 #include "status.h"
 
@@ -24,6 +25,7 @@ void wc_cloth_destroy(wc_cloth *c)
     wc_free(c->contact);
     wc_free(c->history_override);
     wc_self_state_destroy(c->self);
+    wc_feature_state_destroy(c->features);
     wc_topology_free(&c->topology);
     wc_free(c);
 }

@@ -76,6 +76,9 @@ typedef struct wc_cloth {
     uint8_t *history_override;
     /// Self-collision buffers; NULL when self-collision is off.
     struct wc_self_state *self;
+    /// Buffers for collider vertices and edges against this cloth; made
+    /// at the first step with a mesh collider.
+    struct wc_feature_state *features;
 } wc_cloth;
 
 /// Creates a cloth from a validated description. On failure nothing leaks.

@@ -128,6 +128,8 @@ typedef struct particle_motion {
     double end[3];   /* position at the end, as corrected so far */
     double vel[3];   /* velocity after the step, as corrected so far */
     double normal[3];
+    /* velocity of the surface point it last touched (for the fail-safe) */
+    double surface_velocity[3];
     int touched;
 } particle_motion;
 
@@ -156,7 +158,7 @@ static void respond(particle_motion *m, const double surface[3], const double n[
             m->vel[k] = v_surface[k] + keep * tangent[k];
         }
     }
-    for (int k = 0; k < 3; ++k) m->normal[k] = n[k];
+    for (int k = 0; k < 3; ++k) m->normal[k] = n[k], m->surface_velocity[k] = v_surface[k];
     m->touched = 1;
 }
 
@@ -315,17 +317,21 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
                       int threads, wc_step_stats *stats)
 {
     int32_t n = cl->particle_count;
-    int contacts = 0, failsafe = 0;
+    int failsafe = 0;
     double h = cl->material.thickness, mu_cloth = cl->material.friction;
     (void)threads;
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads) if (n >= WC_PARALLEL_MIN) \
-    reduction(+ : contacts, failsafe)
+    reduction(+ : failsafe)
     for (int32_t i = 0; i < n; ++i) {
         if (cl->pin_slot[i] >= 0) continue;
         particle_motion m;
         m.start[0] = cl->x[i], m.start[1] = cl->y[i], m.start[2] = cl->z[i];
         m.end[0] = cl->nx[i], m.end[1] = cl->ny[i], m.end[2] = cl->nz[i];
-        for (int k = 0; k < 3; ++k) m.vel[k] = (m.end[k] - m.start[k]) / dt;
+        /* the velocity so far: through the history override if an earlier
+         * response this step already set one */
+        double from[3] = {m.start[0], m.start[1], m.start[2]};
+        if (cl->history_override[i]) from[0] = cl->qx[i], from[1] = cl->qy[i], from[2] = cl->qz[i];
+        for (int k = 0; k < 3; ++k) m.vel[k] = (m.end[k] - from[k]) / dt;
         m.touched = 0;
         /* One collider's candidates are kept across passes; with several
          * mesh colliders the others are queried again each pass. */
@@ -349,8 +355,13 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
         if (!m.touched) continue;
         if (moved) {
             /* Still pushed around after every pass: wedged between
-             * surfaces. Fail-safe: stay where the step started, at rest. */
-            for (int k = 0; k < 3; ++k) m.end[k] = m.start[k], m.vel[k] = 0.0;
+             * surfaces. Fail-safe: keep the place relative to the surface
+             * it last touched that it had at the start of the step, free of
+             * intersection: move with that surface (at rest if static). */
+            for (int k = 0; k < 3; ++k) {
+                m.vel[k] = m.surface_velocity[k];
+                m.end[k] = m.start[k] + m.vel[k] * dt;
+            }
             ++failsafe;
         }
         cl->nx[i] = m.end[0], cl->ny[i] = m.end[1], cl->nz[i] = m.end[2];
@@ -360,8 +371,6 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
         cl->history_override[i] = 1;
         cl->contact[i] = WC_CONTACT_COLLIDER;
         cl->normal_x[i] = m.normal[0], cl->normal_y[i] = m.normal[1], cl->normal_z[i] = m.normal[2];
-        ++contacts;
     }
-    stats->collider_contacts += contacts;
     stats->failsafe_particles += failsafe;
 }

@@ -14,7 +14,7 @@
 /// Moves each particle's end-of-step position (nx/ny/nz) out of every
 /// collider, sets its new velocity through the history override and marks
 /// contacts. Particles are independent, so the loop is parallel and its
-/// result the same for any thread count. Adds to stats.
+/// result the same for any thread count. Adds fail-safe particles to stats.
 void wc_collide_cloth(wc_cloth *cloth, wc_collider *const *colliders, int32_t collider_count,
                       double dt, int threads, wc_step_stats *stats);
 

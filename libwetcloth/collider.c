@@ -3,6 +3,7 @@
 #include "collider.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "alloc.h"
@@ -38,6 +39,10 @@ void wc_collider_destroy(wc_collider *c)
 {
     if (!c) return;
     wc_free(c->triangles);
+    wc_free(c->edges);
+    wc_free(c->triangle_edges);
+    wc_free(c->vertex_stamp);
+    wc_free(c->edge_stamp);
     wc_free(c->current);
     wc_free(c->target);
     wc_free(c->next);
@@ -47,6 +52,55 @@ void wc_collider_destroy(wc_collider *c)
     wc_grid_free(&c->grid);
     wc_convex_shape_free(&c->convex);
     wc_free(c);
+}
+
+static int compare_triples(const void *pa, const void *pb)
+{
+    const int32_t *p = pa, *q = pb;
+    for (int k = 0; k < 3; ++k)
+        if (p[k] != q[k]) return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+/* The unique edges of a mesh collider's triangles, sorted, each triangle's
+ * three edge ids, and the feature pass's scratch. Entries (a, b, where) are
+ * sorted so equal edges become neighbours; `where` is 3 * triangle + corner. */
+static int build_edges(wc_collider *c)
+{
+    size_t n = 3 * (size_t)c->triangle_count;
+    int32_t *entries = wc_alloc_array(3 * n, sizeof *entries);
+    c->edges = wc_alloc_array(2 * n, sizeof *c->edges);
+    c->triangle_edges = wc_alloc_array(n, sizeof *c->triangle_edges);
+    c->vertex_stamp = wc_alloc_array((size_t)c->vertex_count, sizeof *c->vertex_stamp);
+    c->edge_stamp = wc_alloc_array(n, sizeof *c->edge_stamp);
+    if (!entries || !c->edges || !c->triangle_edges || !c->vertex_stamp || !c->edge_stamp) {
+        wc_free(entries);
+        return 0;
+    }
+    for (size_t t = 0; t < (size_t)c->triangle_count; ++t)
+        for (int k = 0; k < 3; ++k) {
+            int32_t a = c->triangles[3 * t + k], b = c->triangles[3 * t + (k + 1) % 3];
+            int32_t *e = entries + 3 * (3 * t + k);
+            e[0] = a < b ? a : b, e[1] = a < b ? b : a, e[2] = (int32_t)(3 * t + k);
+        }
+    qsort(entries, n, 3 * sizeof *entries, compare_triples);
+    int32_t unique = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const int32_t *e = entries + 3 * k;
+        if (e[0] == e[1]) { /* a degenerate triangle's collapsed edge */
+            c->triangle_edges[e[2]] = -1;
+            continue;
+        }
+        if (!unique || e[0] != c->edges[2 * unique - 2] || e[1] != c->edges[2 * unique - 1]) {
+            c->edges[2 * unique] = e[0];
+            c->edges[2 * unique + 1] = e[1];
+            ++unique;
+        }
+        c->triangle_edges[e[2]] = unique - 1;
+    }
+    c->edge_count = unique;
+    wc_free(entries);
+    return 1;
 }
 
 static wc_status append_collider(wc_world *w, wc_collider *c, int32_t *out)
@@ -137,6 +191,10 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
         return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
     }
     memcpy(c->triangles, d->triangles, 3 * nt * sizeof *c->triangles);
+    if (!build_edges(c)) {
+        wc_collider_destroy(c);
+        return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
+    }
     memcpy(c->current, d->vertices, nv * sizeof *c->current);
     memcpy(c->target, d->vertices, nv * sizeof *c->target);
     memcpy(c->next, d->vertices, nv * sizeof *c->next);

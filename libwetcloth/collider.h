@@ -40,6 +40,16 @@ typedef struct wc_collider {
     int32_t vertex_count;
     int32_t triangle_count;
     int32_t *triangles;
+    /// Unique edges of the triangles, 2 vertex indices each, and the 3 edge
+    /// ids of each triangle (-1 for a degenerate triangle's collapsed edge).
+    int32_t edge_count;
+    int32_t *edges;
+    int32_t *triangle_edges;
+    /// Scratch for the feature pass (collide_features.c): the last query
+    /// that listed each vertex and edge, so each is tested once per query.
+    int64_t *vertex_stamp;
+    int64_t *edge_stamp;
+    int64_t stamp;
     /// Vertex positions now, xyz per vertex.
     double *current;
     /// Vertex positions at the end of the running advance.

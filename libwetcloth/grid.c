@@ -136,34 +136,50 @@ wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double c
     return WC_OK;
 }
 
-/* Keeps out[0 .. n) sorted and unique; n may pass capacity (then only counted). */
-static int32_t insert_sorted(int32_t *out, int32_t n, int32_t capacity, int32_t item)
+/* Sorts out[0 .. n) (short lists: insertion sort). */
+static void sort_items(int32_t *out, int32_t n)
 {
-    int32_t stored = n < capacity ? n : capacity;
-    int32_t lo = 0, hi = stored;
-    while (lo < hi) {
-        int32_t mid = (lo + hi) / 2;
-        if (out[mid] < item) lo = mid + 1;
-        else hi = mid;
+    for (int32_t i = 1; i < n; ++i) {
+        int32_t item = out[i], j = i;
+        while (j > 0 && out[j - 1] > item) out[j] = out[j - 1], --j;
+        out[j] = item;
     }
-    if (lo < stored && out[lo] == item) return n;
-    if (n >= capacity) return n + 1; /* overflowing: count only (may over-count duplicates) */
-    memmove(out + lo + 1, out + lo, (size_t)(stored - lo) * sizeof *out);
-    out[lo] = item;
+}
+
+/* Writes an item if there is room; returns the new count either way. */
+static int32_t emit(int32_t *out, int32_t n, int32_t capacity, int32_t item)
+{
+    if (n < capacity) out[n] = item;
     return n + 1;
+}
+
+/* An item overlapping several cells of the query is reported only from the
+ * first of them (the lowest corner of the overlap), so no item comes twice
+ * and nothing has to be searched or merged while collecting. A hash
+ * collision can put an item into a bucket of a cell it does not touch; the
+ * corner test rejects it there, because that cell is not its corner. */
+static int reported_here(const wc_grid *g, const double item[6], const int32_t query_lo[3],
+                         int32_t x, int32_t y, int32_t z)
+{
+    double inv = 1.0 / g->cell_size;
+    int32_t cx = cell_of(item[0], inv), cy = cell_of(item[1], inv), cz = cell_of(item[2], inv);
+    if (cx < query_lo[0]) cx = query_lo[0];
+    if (cy < query_lo[1]) cy = query_lo[1];
+    if (cz < query_lo[2]) cz = query_lo[2];
+    return cx == x && cy == y && cz == z;
 }
 
 int32_t wc_grid_query(const wc_grid *g, const double box[6], int32_t *out, int32_t capacity)
 {
     int32_t n = 0;
     for (int32_t k = 0; k < g->large_count; ++k)
-        if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)g->large[k]))
-            n = insert_sorted(out, n, capacity, g->large[k]);
+        if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)g->large[k])) n = emit(out, n, capacity, g->large[k]);
     int32_t lo[3], hi[3];
     cell_range(box, 1.0 / g->cell_size, lo, hi);
     if (cells_in(lo, hi) > MAX_CELLS_PER_QUERY) {
+        n = 0; /* scan all instead, in order (the large items come again) */
         for (int32_t i = 0; i < g->item_count; ++i)
-            if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)i)) n = insert_sorted(out, n, capacity, i);
+            if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)i)) n = emit(out, n, capacity, i);
         return n;
     }
     for (int32_t z = lo[2]; z <= hi[2]; ++z)
@@ -171,10 +187,11 @@ int32_t wc_grid_query(const wc_grid *g, const double box[6], int32_t *out, int32
             for (int32_t x = lo[0]; x <= hi[0]; ++x) {
                 uint32_t b = bucket_of(g, x, y, z);
                 for (int32_t k = g->start[b]; k < g->start[b + 1]; ++k) {
-                    int32_t item = g->items[k];
-                    if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)item))
-                        n = insert_sorted(out, n, capacity, item);
+                    const double *item = g->boxes + 6 * (size_t)g->items[k];
+                    if (wc_boxes_overlap(box, item) && reported_here(g, item, lo, x, y, z))
+                        n = emit(out, n, capacity, g->items[k]);
                 }
             }
+    if (n <= capacity) sort_items(out, n);
     return n;
 }

@@ -5,6 +5,7 @@
 
 #include "alloc.h"
 #include "collide.h"
+#include "collide_features.h"
 #include "forces.h"
 #include "integrate.h"
 #include "parallel.h"
@@ -129,8 +130,24 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
         wc_cloth *cl = w->cloths[c];
         memset(cl->contact, 0, (size_t)cl->particle_count);
         memset(cl->history_override, 0, (size_t)cl->particle_count);
-        if (w->collider_count)
+        /* Particles against collider faces, then collider vertices and edges
+         * against the cloth's triangles and edges; the second can push a
+         * particle back toward a face, so the two alternate until the
+         * second has nothing left to do. */
+        for (int round = 0; round < 3 && w->collider_count; ++round) {
             wc_collide_cloth(cl, w->colliders, w->collider_count, dt, threads, &w->stats);
+            if (!cl->features && !(cl->features = wc_feature_state_create(cl)))
+                return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                               "out of memory for the collision buffers of cloth %d; the world "
+                               "keeps its last good state", (int)c);
+            int moved;
+            if (wc_collide_features(cl, cl->features, w->colliders, w->collider_count, dt,
+                                    &w->stats, &moved))
+                return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                               "out of memory indexing cloth %d for collisions; the world keeps "
+                               "its last good state", (int)c);
+            if (!moved) break;
+        }
         if (cl->self && wc_self_collide(cl, dt, threads, &w->stats))
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory in the self-collision of cloth %d; the world keeps its "
@@ -141,6 +158,10 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
             bad = wc_first_non_finite(v, cl->particle_count);
         }
         if (bad >= 0) return non_finite_error(w, dt, c, (int32_t)bad, "collision response");
+        /* counted once at the end: the passes above may visit a particle
+         * more than once (self-collision counts its own contacts) */
+        for (int32_t i = 0; i < cl->particle_count; ++i)
+            w->stats.collider_contacts += cl->contact[i] == WC_CONTACT_COLLIDER;
     }
     return WC_OK;
 }

@@ -6,7 +6,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
+#include "primitives.h"
 #include "scenes.h"
 #include "test_util.h"
 #include "wetcloth.h"
@@ -209,8 +211,30 @@ static void fast_plate(void)
     wc_world_destroy(w);
 }
 
+/* Particles within `within` of the thesis sphere's surface, by brute force
+ * over its triangles (independent of the solver's broadphase). */
+static int near_sphere(const wc_world *w, int32_t cloth, double radius, double within)
+{
+    double v[3 * 114], p[3 * 400], bary[3];
+    int32_t t[3 * 224], nt, near = 0, n = wc_cloth_particle_count(w, cloth);
+    scene_uv_sphere(radius, 16, 8, v, t, &nt);
+    wc_cloth_get_positions(w, cloth, p, n);
+    for (int32_t i = 0; i < n; ++i) {
+        double best = INFINITY;
+        for (int32_t k = 0; k < nt; ++k)
+            best = fmin(best, wc_point_triangle_closest(p + 3 * i, v + 3 * t[3 * k], v + 3 * t[3 * k + 1],
+                                                        v + 3 * t[3 * k + 2], bary));
+        near += sqrt(best) < within;
+    }
+    return near;
+}
+
 /* The thesis scene: a 20 x 20 grid cloth 0.6 m above the 114-vertex UV
- * sphere (radius 0.3 m), 48 frames at 24 fps. */
+ * sphere (radius 0.3 m), 48 frames at 24 fps. No intersection at any frame,
+ * and at the end the cloth lies on the sphere: more than 50 of its 400
+ * particles within twice the contact distance (1 cm) of the surface (the
+ * cloth covers the upper half of the sphere; a cloth that slid off or stood
+ * off would have none). */
 static void thesis_scene(void)
 {
     wc_world *w = scene_world(1);
@@ -220,18 +244,18 @@ static void thesis_scene(void)
     g.center[2] = 0.6;
     int32_t cl;
     CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
-    int total = 0, touching = 0;
+    int total = 0;
     for (int f = 0; f < 48; ++f) {
         advance_or_fail(w, 1.0 / 24, 0);
         wc_intersection_counts counts;
         CHECK(wc_world_count_intersections(w, &counts) == WC_OK, "%s", wc_world_last_error(w));
         total += counts.cloth_cloth + counts.cloth_collider;
-        touching = wc_world_get_stats(w).collider_contacts;
     }
-    printf("thesis scene: %d intersections over 48 frames, %d particles touching at the end\n",
-           total, touching);
+    int near = near_sphere(w, cl, 0.3, 2 * g.material.thickness);
+    printf("thesis scene: %d intersections over 48 frames, %d particles within %.0f mm of the "
+           "sphere at the end\n", total, near, 2e3 * g.material.thickness);
     CHECK(total == 0, "%d intersections", total);
-    CHECK(touching > 50, "only %d particles touch the sphere", touching);
+    CHECK(near > 50, "only %d particles lie on the sphere", near);
     wc_world_destroy(w);
 }
 
@@ -242,11 +266,11 @@ static uint64_t sphere_drop_hash(int32_t threads)
     scene_add_thesis_sphere(w, 0.3);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = 64;
-    g.center[2] = 0.36;
+    g.center[2] = 0.31; /* just above the sphere: contact in the first frame */
     g.material.stretch_stiffness = 100.0; /* fewer substeps: keeps the test short */
     int32_t cl;
     CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
-    for (int f = 0; f < 5; ++f) advance_or_fail(w, 1.0 / 24, 0);
+    for (int f = 0; f < 2; ++f) advance_or_fail(w, 1.0 / 24, 0);
     CHECK(wc_world_get_stats(w).collider_contacts > 0, "no contact with %d threads", threads);
     uint64_t h = scene_hash_positions(w, cl);
     wc_world_destroy(w);
@@ -261,16 +285,26 @@ static void determinism(void)
     CHECK(h1 == h2 && h1 == h4, "hashes differ across thread counts");
 }
 
+static double seconds(void)
+{
+    return (double)clock() / CLOCKS_PER_SEC;
+}
+
 int main(void)
 {
+    double t0 = seconds();
     rest_on_triangle();
     rest_on_convex(WC_SHAPE_SPHERE, "sphere");
     rest_on_convex(WC_SHAPE_CAPSULE, "capsule");
     rest_on_convex(WC_SHAPE_BOX, "box");
     rest_on_convex(WC_SHAPE_CONVEX_HULL, "hull");
     fast_particle();
+    printf("(%.1f s) ", seconds() - t0);
     fast_plate();
+    printf("(%.1f s) ", seconds() - t0);
     thesis_scene();
+    printf("(%.1f s) ", seconds() - t0);
     determinism();
+    printf("(%.1f s)\n", seconds() - t0);
     return test_report("test_collide");
 }
