@@ -189,6 +189,41 @@ typedef struct wc_material {
     /// Coulomb friction coefficient against colliders and itself, [0, 10].
     /// A contact uses sqrt(cloth friction * collider friction). Default 0.5.
     double friction;
+
+    /* Wetness (thesis 2.3-2.4). Each takes effect in proportion to a
+     * particle's wetness w in [0, 1]; a dry cloth (w = 0 everywhere) behaves,
+     * bit for bit and at no extra cost, as if they were all zero. */
+
+    /// Adhesion pressure of soaked cloth (w = 1), Pa, [0, 1e6]: a particle of
+    /// area A in contact is pulled toward the surface with s w, s = adhesion * A
+    /// (thesis eq. 2.8), every step while in contact. Default 30 (about 10
+    /// times the weight of soaked cotton per area: it holds on a vertical
+    /// wall and wraps round what it falls on).
+    double adhesion;
+    /// Spread factor beta, [0, 1]: a particle linked to a stuck one is pulled
+    /// toward the same surface with s w beta l / d per stuck neighbour (l the
+    /// link's rest length, d its length now), at most s w in all (thesis
+    /// eq. 2.9). Default 0.5.
+    double spread;
+    /// Wet friction q, [0, 1]: in sustained contact (this step and the last),
+    /// the tangential velocity relative to the surface is scaled by
+    /// 1 - w (1 - q) on top of Coulomb friction (thesis eq. 2.10); 1 = no
+    /// extra friction. Default 0.05.
+    double wet_friction;
+    /// Water uptake at w = 1 as a fraction of dry mass, [0, 10]: mass is
+    /// multiplied by 1 + wet_mass_gain * w. Default 1.0 (100 %; cotton takes
+    /// up 50-200 %).
+    double wet_mass_gain;
+    /// Softening at w = 1, [0, 0.99]: stretch and bend stiffness are
+    /// multiplied by 1 - wet_softening * w (the link's mean wetness).
+    /// Default 0.3.
+    double wet_softening;
+    /// Wicking: wetness diffuses along stretch links at this rate, m^2/s,
+    /// [0, 1]. 0 (default) = off, and costs nothing.
+    double wicking;
+    /// Drying: wetness decays as dw/dt = -drying * w, 1/s, [0, 100].
+    /// 0 (default) = off, and costs nothing.
+    double drying;
 } wc_material;
 
 /// The default material (plausible cotton).
@@ -218,6 +253,8 @@ typedef struct wc_mesh_cloth_def {
     /// 1 to keep the cloth from passing through itself, 0 (default) not to.
     /// Off costs nothing.
     int32_t self_collision;
+    /// Starting wetness of every particle, [0, 1]. Default 0 (dry).
+    double wetness;
 } wc_mesh_cloth_def;
 
 /// Default mesh cloth description (no geometry, default material).
@@ -247,6 +284,8 @@ typedef struct wc_grid_cloth_def {
     wc_material material;
     /// 1 to keep the cloth from passing through itself, 0 (default) not to.
     int32_t self_collision;
+    /// Starting wetness of every particle, [0, 1]. Default 0 (dry).
+    double wetness;
 } wc_grid_cloth_def;
 
 /// Default grid: 32 x 32 particles, 1 m x 1 m in the plane z = 0.
@@ -342,6 +381,11 @@ typedef struct wc_cloth_view {
     const double *normal_x;
     const double *normal_y;
     const double *normal_z;
+    /// Wetness of each particle, [0, 1].
+    const double *wetness;
+    /// 1 where a particle is stuck: wet and in contact in the last step and
+    /// the one before (held by adhesion and wet friction), else 0.
+    const uint8_t *stuck;
 } wc_cloth_view;
 
 /// Fills a view of a cloth's particles.
@@ -390,6 +434,22 @@ WC_API wc_status wc_cloth_get_energy(const wc_world *world, int32_t cloth, wc_en
 /// Either output may be NULL. count must equal the particle count.
 WC_API wc_status wc_cloth_get_contacts(const wc_world *world, int32_t cloth, uint8_t *out_kind,
                                        double *out_normals_xyz, int32_t count);
+
+/// Sets the wetness of every particle to one value in [0, 1].
+WC_API wc_status wc_cloth_set_wetness_uniform(wc_world *world, int32_t cloth, double wetness);
+
+/// Sets each particle's wetness (count values in [0, 1], count = the
+/// particle count): a wetness map, e.g. from a Blender vertex group.
+WC_API wc_status wc_cloth_set_wetness(wc_world *world, int32_t cloth, const double *wetness,
+                                      int32_t count);
+
+/// Copies each particle's wetness (count values).
+WC_API wc_status wc_cloth_get_wetness(const wc_world *world, int32_t cloth, double *out_wetness,
+                                      int32_t count);
+
+/// Copies each particle's stuck flag (count values, 0 or 1; see wc_cloth_view).
+WC_API wc_status wc_cloth_get_stuck(const wc_world *world, int32_t cloth, uint8_t *out_stuck,
+                                    int32_t count);
 
 /* ------------------------------------------------------------------------ */
 /* Colliders                                                                 */
@@ -497,6 +557,8 @@ typedef struct wc_step_stats {
     /// Particles a fail-safe had to put back where they were at the start of
     /// the step, because no response left them free of intersection.
     int32_t failsafe_particles;
+    /// Particles stuck (wet, in sustained contact) after the step.
+    int32_t stuck_particles;
 } wc_step_stats;
 
 /// Statistics of the last step.

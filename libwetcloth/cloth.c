@@ -16,13 +16,16 @@ void wc_cloth_destroy(wc_cloth *c)
                         c->ny, c->nz, c->fx, c->fy,      c->fz,      c->vx,      c->vy,
                         c->vz, c->mass, c->inv_mass, c->stretch_k, c->stretch_c, c->bend_r,
                         c->link_fx, c->link_fy, c->link_fz, c->pins.from, c->pins.to,
-                        c->normal_x, c->normal_y, c->normal_z, c->qx, c->qy, c->qz};
+                        c->normal_x, c->normal_y, c->normal_z, c->qx, c->qy, c->qz,
+                        c->wetness, c->wetness_next};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
     wc_free(c->link_start);
     wc_free(c->link_list);
     wc_free(c->pin_slot);
     wc_free(c->pins.particle);
     wc_free(c->contact);
+    wc_free(c->contact_prev);
+    wc_free(c->stuck);
     wc_free(c->history_override);
     wc_self_state_destroy(c->self);
     wc_feature_state_destroy(c->features);
@@ -61,8 +64,13 @@ static int alloc_particle_arrays(wc_cloth *c)
           alloc_doubles(&c->normal_z, n) & alloc_doubles(&c->qx, n) & alloc_doubles(&c->qy, n) &
           alloc_doubles(&c->qz, n);
     c->contact = wc_alloc_array(n, sizeof *c->contact);
+    c->contact_prev = wc_alloc_array(n, sizeof *c->contact_prev);
+    c->stuck = wc_alloc_array(n, sizeof *c->stuck);
     c->history_override = wc_alloc_array(n, sizeof *c->history_override);
-    return ok && c->link_start && c->link_list && c->pin_slot && c->contact && c->history_override;
+    ok &= alloc_doubles(&c->wetness, n);
+    if (c->material.wicking > 0.0) ok &= alloc_doubles(&c->wetness_next, n);
+    return ok && c->link_start && c->link_list && c->pin_slot && c->contact && c->contact_prev &&
+           c->stuck && c->history_override;
 }
 
 /* Per-particle link lists in ascending link order: the order in which a
@@ -133,36 +141,60 @@ static double estimate_stable_dt(const wc_cloth *c)
     return dt;
 }
 
-/* Turns area shares into masses and link constants (see wc_material). */
-static wc_status apply_material(wc_cloth *c, wc_message *msg)
+/* Whether the wet forces can act: some particle wet, the material adhesive. */
+static int any_wet_force(const wc_cloth *c)
+{
+    if (!(c->material.adhesion > 0.0)) return 0;
+    for (int32_t i = 0; i < c->particle_count; ++i)
+        if (c->wetness[i] > 0.0) return 1;
+    return 0;
+}
+
+/* Turns area shares into masses and link constants (see wc_material),
+ * wetness included: mass * (1 + gain w), stiffness * (1 - softening w),
+ * w a link's mean wetness. For w = 0 both factors are exactly 1, so a dry
+ * cloth gets bitwise the plain model's constants. */
+void wc_cloth_apply_material(wc_cloth *c)
 {
     const wc_topology *t = &c->topology;
     const wc_material *m = &c->material;
+    const double *w = c->wetness;
     for (int32_t i = 0; i < c->particle_count; ++i) {
-        c->mass[i] = m->density * t->area[i];
+        c->mass[i] = m->density * t->area[i] * (1.0 + m->wet_mass_gain * w[i]);
         c->inv_mass[i] = 1.0 / c->mass[i];
     }
     for (int32_t e = 0; e < t->stretch.count; ++e) {
-        double l = t->stretch.rest[e];
-        if (!(l > 0.0))
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
-                           "cloth vertices %d and %d are linked but lie at the same point",
-                           (int)t->stretch.a[e], (int)t->stretch.b[e]);
-        c->stretch_k[e] = m->stretch_stiffness * t->stretch.share[e] / (l * l);
+        int32_t a = t->stretch.a[e], b = t->stretch.b[e];
+        double l = t->stretch.rest[e], soft = 1.0 - m->wet_softening * 0.5 * (w[a] + w[b]);
+        c->stretch_k[e] = m->stretch_stiffness * t->stretch.share[e] / (l * l) * soft;
         if (c->stretch_c) {
-            double ma = c->mass[t->stretch.a[e]], mb = c->mass[t->stretch.b[e]];
+            double ma = c->mass[a], mb = c->mass[b];
             c->stretch_c[e] = 2.0 * m->stretch_damping * sqrt(c->stretch_k[e] * ma * mb / (ma + mb));
         }
     }
-    for (int32_t e = 0; e < t->bend.count; ++e)
-        c->bend_r[e] = m->bend_stiffness * t->bend.share[e] / t->bend.rest[e];
+    for (int32_t e = 0; e < t->bend.count; ++e) {
+        double soft = 1.0 - m->wet_softening * 0.5 * (w[t->bend.a[e]] + w[t->bend.b[e]]);
+        c->bend_r[e] = m->bend_stiffness * t->bend.share[e] / t->bend.rest[e] * soft;
+    }
     c->stable_dt = estimate_stable_dt(c);
+    c->wet_forces = any_wet_force(c);
+}
+
+/* Every link must join two distinct points of the rest shape. */
+static wc_status check_links(const wc_cloth *c, wc_message *msg)
+{
+    const wc_link_set *s = &c->topology.stretch;
+    for (int32_t e = 0; e < s->count; ++e)
+        if (!(s->rest[e] > 0.0))
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                           "cloth vertices %d and %d are linked but lie at the same point",
+                           (int)s->a[e], (int)s->b[e]);
     return WC_OK;
 }
 
 wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const int32_t *faces,
                           int32_t face_count, int32_t face_size, const wc_material *material,
-                          int self_collision, wc_message *msg)
+                          int self_collision, double wetness, wc_message *msg)
 {
     *out = NULL;
     wc_cloth *c = wc_alloc_array(1, sizeof *c);
@@ -194,11 +226,13 @@ wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const in
                            (int)n);
         }
     }
-    s = apply_material(c, msg);
+    s = check_links(c, msg);
     if (s) {
         wc_cloth_destroy(c);
         return s;
     }
+    for (int32_t i = 0; i < n; ++i) c->wetness[i] = wetness;
+    wc_cloth_apply_material(c);
     *out = c;
     return WC_OK;
 }

@@ -79,12 +79,26 @@ typedef struct wc_cloth {
     /// Buffers for collider vertices and edges against this cloth; made
     /// at the first step with a mesh collider.
     struct wc_feature_state *features;
+
+    /* Wetness. */
+    /// Wetness of each particle, [0, 1].
+    double *wetness;
+    /// Contact kind of each particle in the step before the last one.
+    uint8_t *contact_prev;
+    /// Stuck: wet and in contact in the last two steps.
+    uint8_t *stuck;
+    /// Whether the wet forces can act at all (some particle wet and the
+    /// material adhesive): a dry cloth skips them entirely.
+    int wet_forces;
+    /// Scratch for wicking (NULL unless the material wicks).
+    double *wetness_next;
 } wc_cloth;
 
 /// Creates a cloth from a validated description. On failure nothing leaks.
 wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t vertex_count,
                           const int32_t *faces, int32_t face_count, int32_t face_size,
-                          const wc_material *material, int self_collision, wc_message *msg);
+                          const wc_material *material, int self_collision, double wetness,
+                          wc_message *msg);
 
 void wc_cloth_destroy(wc_cloth *cloth);
 
@@ -92,6 +106,10 @@ void wc_cloth_destroy(wc_cloth *cloth);
 /// overrides, particles whose history_override is set get q as their
 /// previous position, which carries the velocity a collision gave them.
 void wc_cloth_commit(wc_cloth *cloth, double dt, int with_overrides);
+
+/// Derives masses, link constants and the stable step from the material and
+/// the current wetness (see wc_material). Call after wetness changes.
+void wc_cloth_apply_material(wc_cloth *cloth);
 
 /// Velocity of particle i, m/s (see wc_cloth_get_velocities).
 void wc_cloth_velocity(const wc_cloth *cloth, int32_t i, double v[3]);

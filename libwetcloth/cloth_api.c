@@ -78,11 +78,14 @@ wc_status wc_world_add_mesh_cloth(wc_world *w, const wc_mesh_cloth_def *d, int32
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.self_collision must be 0 or 1 but is %d",
                        (int)d->self_collision);
+    if (!(d->wetness >= 0.0 && d->wetness <= 1.0))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_cloth_def.wetness must be in [0, 1] but is %g", d->wetness);
     wc_status s = wc_material_validate(&d->material, msg);
     if (s) return s;
     wc_cloth *c;
     s = wc_cloth_create(&c, d->vertices, d->vertex_count, d->faces, d->face_count, d->face_size,
-                        &d->material, d->self_collision, msg);
+                        &d->material, d->self_collision, d->wetness, msg);
     if (s) return s;
     return append_cloth(w, c, out_cloth);
 }
@@ -120,6 +123,9 @@ static wc_status validate_grid(const wc_grid_cloth_def *d, wc_message *msg)
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.self_collision must be 0 or 1 but is %d",
                        (int)d->self_collision);
+    if (!(d->wetness >= 0.0 && d->wetness <= 1.0))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "grid_cloth_def.wetness must be in [0, 1] but is %g", d->wetness);
     return wc_material_validate(&d->material, msg);
 }
 
@@ -156,7 +162,8 @@ wc_status wc_world_add_grid_cloth(wc_world *w, const wc_grid_cloth_def *d, int32
             f[3] = (j + 1) * nu + i;
         }
     wc_cloth *c;
-    s = wc_cloth_create(&c, xyz, n, faces, quads, 4, &d->material, d->self_collision, &w->error);
+    s = wc_cloth_create(&c, xyz, n, faces, quads, 4, &d->material, d->self_collision, d->wetness,
+                        &w->error);
     wc_free(xyz);
     wc_free(faces);
     if (s) return s;
@@ -345,6 +352,8 @@ wc_status wc_cloth_get_view(const wc_world *w, int32_t cloth, wc_cloth_view *out
     out->normal_x = c->normal_x;
     out->normal_y = c->normal_y;
     out->normal_z = c->normal_z;
+    out->wetness = c->wetness;
+    out->stuck = c->stuck;
     return WC_OK;
 }
 
@@ -507,5 +516,55 @@ wc_status wc_cloth_get_contacts(const wc_world *w, int32_t cloth, uint8_t *out_k
             out_normals[3 * (size_t)i + 2] = c->normal_z[i];
         }
     }
+    return WC_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Wetness                                                                   */
+/* ------------------------------------------------------------------------ */
+
+wc_status wc_cloth_set_wetness_uniform(wc_world *w, int32_t cloth, double wetness)
+{
+    if (!w) return WC_ERROR_INVALID_ARGUMENT;
+    wc_cloth *c = wc_world_find_cloth(w, cloth, "wc_cloth_set_wetness_uniform");
+    if (!c) return WC_ERROR_NOT_FOUND;
+    if (!(wetness >= 0.0 && wetness <= 1.0))
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                       "wc_cloth_set_wetness_uniform: wetness must be in [0, 1] but is %g", wetness);
+    for (int32_t i = 0; i < c->particle_count; ++i) c->wetness[i] = wetness;
+    wc_cloth_apply_material(c);
+    return WC_OK;
+}
+
+wc_status wc_cloth_set_wetness(wc_world *w, int32_t cloth, const double *wetness, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, wetness, count, wc_cloth_particle_count(w, cloth),
+                                   "wc_cloth_set_wetness");
+    if (!c) return lookup_status(w, cloth);
+    for (int32_t i = 0; i < count; ++i)
+        if (!(wetness[i] >= 0.0 && wetness[i] <= 1.0))
+            return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+                           "wc_cloth_set_wetness: wetness[%d] must be in [0, 1] but is %g", (int)i,
+                           wetness[i]);
+    memcpy(c->wetness, wetness, (size_t)count * sizeof *wetness);
+    wc_cloth_apply_material(c);
+    return WC_OK;
+}
+
+wc_status wc_cloth_get_wetness(const wc_world *w, int32_t cloth, double *out, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, out, count, wc_cloth_particle_count(w, cloth),
+                                   "wc_cloth_get_wetness");
+    if (!c) return lookup_status(w, cloth);
+    memcpy(out, c->wetness, (size_t)count * sizeof *out);
+    return WC_OK;
+}
+
+wc_status wc_cloth_get_stuck(const wc_world *w, int32_t cloth, uint8_t *out, int32_t count)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, out, count, wc_cloth_particle_count(w, cloth),
+                                   "wc_cloth_get_stuck");
+    if (!c) return lookup_status(w, cloth);
+    memcpy(out, c->stuck, (size_t)count);
     return WC_OK;
 }

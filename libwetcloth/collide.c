@@ -130,6 +130,9 @@ typedef struct particle_motion {
     double normal[3];
     /* velocity of the surface point it last touched (for the fail-safe) */
     double surface_velocity[3];
+    /* factor on the tangential velocity from wet friction: 1 - w (1 - q) in
+     * sustained contact (touching in the last step too), else 1 */
+    double wet_keep;
     int touched;
 } particle_motion;
 
@@ -140,7 +143,7 @@ typedef struct particle_motion {
  * tangential reduction is applied to this step's displacement, so a
  * particle held by friction does not slide during the step either. */
 static void respond(particle_motion *m, const double surface[3], const double n[3],
-                    const double v_surface[3], double r, double mu, double dt)
+                    const double v_surface[3], double r, double mu, double wet_keep, double dt)
 {
     double rel[3], vn, tangent[3], speed_t;
     for (int k = 0; k < 3; ++k) {
@@ -153,6 +156,7 @@ static void respond(particle_motion *m, const double surface[3], const double n[
         speed_t = sqrt(dot3(tangent, tangent));
         double keep = speed_t > 0.0 ? 1.0 - mu * (-vn) / speed_t : 1.0;
         if (keep < 0.0) keep = 0.0;
+        keep *= wet_keep; /* wet friction (thesis eq. 2.10) in sustained contact */
         for (int k = 0; k < 3; ++k) {
             m->end[k] -= (1.0 - keep) * tangent[k] * dt;
             m->vel[k] = v_surface[k] + keep * tangent[k];
@@ -242,7 +246,7 @@ static int mesh_triangle(particle_motion *m, const wc_collider *c, int32_t t, do
     double p0[3], v_surface[3];
     bary_point(t0[0], t0[1], t0[2], w, p0);
     for (int k = 0; k < 3; ++k) v_surface[k] = (cp[k] - p0[k]) / dt;
-    respond(m, cp, n, v_surface, r, mu, dt);
+    respond(m, cp, n, v_surface, r, mu, m->wet_keep, dt);
     return 1;
 }
 
@@ -309,7 +313,7 @@ static int convex_collider(particle_motion *m, const wc_collider *c, double r, d
     wc_pose_to_world(&c->pose_next, out, surface);
     wc_pose_to_world(&c->pose_current, out, before);
     for (int k = 0; k < 3; ++k) v_surface[k] = (surface[k] - before[k]) / dt;
-    respond(m, surface, n, v_surface, r, mu, dt);
+    respond(m, surface, n, v_surface, r, mu, m->wet_keep, dt);
     return 1;
 }
 
@@ -333,6 +337,9 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
         if (cl->history_override[i]) from[0] = cl->qx[i], from[1] = cl->qy[i], from[2] = cl->qz[i];
         for (int k = 0; k < 3; ++k) m.vel[k] = (m.end[k] - from[k]) / dt;
         m.touched = 0;
+        m.wet_keep = cl->contact_prev[i] != WC_CONTACT_NONE
+                         ? 1.0 - cl->wetness[i] * (1.0 - cl->material.wet_friction)
+                         : 1.0;
         /* One collider's candidates are kept across passes; with several
          * mesh colliders the others are queried again each pass. */
         candidates cand;

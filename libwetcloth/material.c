@@ -14,6 +14,13 @@ wc_material wc_material_default(void)
     m.air_drag = 0.02;
     m.thickness = 0.005;
     m.friction = 0.5;
+    m.adhesion = 30.0;
+    m.spread = 0.5;
+    m.wet_friction = 0.05;
+    m.wet_mass_gain = 1.0;
+    m.wet_softening = 0.3;
+    m.wicking = 0.0;
+    m.drying = 0.0;
     return m;
 }
 
@@ -37,5 +44,12 @@ wc_status wc_material_validate(const wc_material *m, wc_message *msg)
     if ((s = check_range(msg, "air_drag", m->air_drag, 0.0, 1e4, 0))) return s;
     if ((s = check_range(msg, "thickness", m->thickness, 0.0, 1.0, 0))) return s;
     if ((s = check_range(msg, "friction", m->friction, 0.0, 10.0, 0))) return s;
+    if ((s = check_range(msg, "adhesion", m->adhesion, 0.0, 1e6, 0))) return s;
+    if ((s = check_range(msg, "spread", m->spread, 0.0, 1.0, 0))) return s;
+    if ((s = check_range(msg, "wet_friction", m->wet_friction, 0.0, 1.0, 0))) return s;
+    if ((s = check_range(msg, "wet_mass_gain", m->wet_mass_gain, 0.0, 10.0, 0))) return s;
+    if ((s = check_range(msg, "wet_softening", m->wet_softening, 0.0, 0.99, 0))) return s;
+    if ((s = check_range(msg, "wicking", m->wicking, 0.0, 1.0, 0))) return s;
+    if ((s = check_range(msg, "drying", m->drying, 0.0, 100.0, 0))) return s;
     return WC_OK;
 }

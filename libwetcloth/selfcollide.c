@@ -144,9 +144,10 @@ struct wc_self_state {
     /// each adjacency entry (overlapping neighbours culled together).
     uint8_t *patch_culled, *adjacent_culled, *patch_touched;
     wc_grid patch_grid;
-    /// Patch pairs (P <= Q) opened up into element pairs.
-    int32_t *open;
-    int64_t open_count, open_capacity;
+    /// Patch pairs (P <= Q) opened up into element pairs, and the triples
+    /// (P, Q, R) of patches two apart culled with R between them.
+    int32_t *open, *joined;
+    int64_t open_count, open_capacity, joined_count, joined_capacity;
     pair_slice slices[SLICES];
     /// Candidates: vertex-face (vertex, triangle) and edge-edge (edge, edge)
     /// pairs, with the status of their last evaluation (0 none, 1 proximity,
@@ -551,7 +552,7 @@ void wc_self_state_destroy(wc_self_state *s)
     void *blocks[] = {s->edges, s->triangle_edges, s->edge_owner, s->rest, s->triangle_patch,
                       s->particle_boxes, s->triangle_boxes, s->edge_boxes, s->triangle_normals,
                       s->patch_boxes, s->patch_grown, s->patch_axis, s->patch_cos,
-                      s->patch_culled, s->adjacent_culled, s->patch_touched, s->open, s->vf,
+                      s->patch_culled, s->adjacent_culled, s->patch_touched, s->open, s->joined, s->vf,
                       s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
     csr_free(&s->patch_triangles);
@@ -635,23 +636,51 @@ static void patch_cone(wc_self_state *s, int32_t p)
     s->patch_cos[p] = cosine;
 }
 
-/* Whether two patches' cones fit in one cone of half-angle acos(CONE_COS):
- * around the bisector d of the axes, a normal is at most its patch's
- * half-angle plus half the angle between the axes away from d. */
-static int cones_join(const wc_self_state *s, int32_t p, int32_t q)
+/* Whether the cones of `count` patches fit in one cone of half-angle
+ * acos(CONE_COS) around d, the normalised sum of their axes: a normal is at
+ * most its patch's half-angle plus the angle between that patch's axis and
+ * d away from d. */
+static int cones_fit(const wc_self_state *s, const int32_t *patches, int count)
 {
-    double cp = s->patch_cos[p], cq = s->patch_cos[q];
-    if (!(cp > CONE_COS && cq > CONE_COS)) return 0;
-    double between = dot3(s->patch_axis + 3 * (size_t)p, s->patch_axis + 3 * (size_t)q);
-    if (between > 1.0) between = 1.0;
-    if (between < -1.0) between = -1.0;
-    double spread = acos(min2(cp, cq)) + 0.5 * acos(between);
-    return spread < acos(CONE_COS);
+    double d[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < count; ++k) {
+        if (!(s->patch_cos[patches[k]] > CONE_COS)) return 0;
+        for (int m = 0; m < 3; ++m) d[m] += s->patch_axis[3 * (size_t)patches[k] + m];
+    }
+    if (!normalize3(d)) return 0;
+    for (int k = 0; k < count; ++k) {
+        double c = dot3(s->patch_axis + 3 * (size_t)patches[k], d);
+        c = c > 1.0 ? 1.0 : c < -1.0 ? -1.0 : c;
+        if (!(acos(s->patch_cos[patches[k]]) + acos(c) < acos(CONE_COS))) return 0;
+    }
+    return 1;
+}
+
+/* A common neighbour r of non-adjacent patches p and q through which the
+ * three form one connected region within a common cone, or -1. */
+static int32_t joining_patch(const wc_self_state *s, int32_t p, int32_t q)
+{
+    const csr *adj = &s->patch_adjacent;
+    int32_t i = adj->start[p], j = adj->start[q];
+    while (i < adj->start[p + 1] && j < adj->start[q + 1]) {
+        int32_t a = adj->items[i], b = adj->items[j];
+        if (a < b) {
+            ++i;
+        } else if (b < a) {
+            ++j;
+        } else {
+            int32_t three[3] = {p, a, q};
+            if (cones_fit(s, three, 3)) return a;
+            ++i, ++j;
+        }
+    }
+    return -1;
 }
 
 /* Patch-level pairs of the patches in [first, end): for each P, every
- * Q >= P whose grown box meets P's box. Pushes (P, Q) for a pair to open,
- * (P, ~Q) for neighbours culled together. */
+ * Q >= P whose grown box meets P's box, as triples (P, Q, how): how = -1 for
+ * a pair to open, -2 for neighbours culled together, r >= 0 for patches two
+ * apart culled together with their common neighbour r. */
 static void patch_pairs_slice(wc_self_state *s, pair_slice *sl, int32_t first, int32_t end)
 {
     for (int32_t p = first; p < end && !sl->failed; ++p) {
@@ -670,23 +699,24 @@ static void patch_pairs_slice(wc_self_state *s, pair_slice *sl, int32_t first, i
         const int32_t *adj = s->patch_adjacent.items + s->patch_adjacent.start[p];
         int32_t adj_count = s->patch_adjacent.start[p + 1] - s->patch_adjacent.start[p];
         for (int32_t k = 0; k < found; ++k) {
-            int32_t q = sl->query[k];
+            int32_t q = sl->query[k], how;
             if (q < p) continue;
             if (q == p) {
-                if (!(s->patch_cos[p] > CONE_COS)) {
-                    if (!grow_int32(&sl->pairs, &sl->capacity, 2 * (sl->count + 1))) sl->failed = 1;
-                    else sl->pairs[2 * sl->count] = p, sl->pairs[2 * sl->count + 1] = p, sl->count++;
-                }
-                continue;
+                if (s->patch_cos[p] > CONE_COS) continue;
+                how = -1;
+            } else if (sorted_contains(adj, adj_count, q) >= 0) {
+                int32_t two[2] = {p, q};
+                how = cones_fit(s, two, 2) ? -2 : -1;
+            } else {
+                how = joining_patch(s, p, q);
+                if (how < 0) how = -1;
             }
-            int culled = sorted_contains(adj, adj_count, q) >= 0 && cones_join(s, p, q);
-            if (!grow_int32(&sl->pairs, &sl->capacity, 2 * (sl->count + 1))) {
+            if (!grow_int32(&sl->pairs, &sl->capacity, 3 * (sl->count + 1))) {
                 sl->failed = 1;
                 return;
             }
-            sl->pairs[2 * sl->count] = p;
-            sl->pairs[2 * sl->count + 1] = culled ? ~q : q;
-            sl->count++;
+            int32_t *out = sl->pairs + 3 * sl->count++;
+            out[0] = p, out[1] = q, out[2] = how;
         }
     }
 }
@@ -704,48 +734,106 @@ static void slice_push(pair_slice *sl, int32_t a, int32_t b)
     sl->count++;
 }
 
-/* Vertices of patch p (owned) against triangles of patch q. */
-static void open_vf(const wc_self_state *s, pair_slice *vf, int32_t p, int32_t q, double h)
+/* Scratch list of the slice (its query buffer, free once the patch pairs
+ * are known), grown to hold `count` items; NULL on out-of-memory. */
+static int32_t *slice_scratch(pair_slice *sl, int32_t count)
+{
+    if (count > sl->query_capacity) {
+        int64_t cap = sl->query_capacity;
+        if (!grow_int32(&sl->query, &cap, count)) {
+            sl->failed = 1;
+            return NULL;
+        }
+        sl->query_capacity = (int32_t)cap;
+    }
+    return sl->query;
+}
+
+/* Whether two elements were within the exclusion distance in the rest
+ * shape: such pairs only need the continuous test (no proximity). */
+static int rest_near_vf(const wc_self_state *s, int32_t v, const int32_t *tri, double exclude2)
+{
+    double bary[3];
+    return wc_point_triangle_closest(s->rest + 3 * (size_t)v, s->rest + 3 * (size_t)tri[0],
+                                     s->rest + 3 * (size_t)tri[1], s->rest + 3 * (size_t)tri[2],
+                                     bary) < exclude2;
+}
+
+static int rest_near_ee(const wc_self_state *s, const int32_t *e, const int32_t *f, double exclude2)
+{
+    double u, v;
+    return wc_segment_segment_closest(s->rest + 3 * (size_t)e[0], s->rest + 3 * (size_t)e[1],
+                                      s->rest + 3 * (size_t)f[0], s->rest + 3 * (size_t)f[1], &u,
+                                      &v) < exclude2;
+}
+
+/* Vertices of patch p (owned) against triangles of patch q: pairs whose
+ * boxes meet, or meet within h when they were not neighbours at rest. */
+static void open_vf(const wc_self_state *s, pair_slice *vf, int32_t p, int32_t q, double h,
+                    double exclude2)
 {
     const csr *own = &s->patch_owned_particles, *tris = &s->patch_triangles;
-    const double *qbox = s->patch_boxes + 6 * (size_t)q;
-    for (int32_t a = own->start[p]; a < own->start[p + 1]; ++a) {
+    const double *pbox = s->patch_boxes + 6 * (size_t)p, *qbox = s->patch_boxes + 6 * (size_t)q;
+    /* q's triangles that reach p at all (triangle boxes include h) */
+    int32_t *near = slice_scratch(vf, tris->start[q + 1] - tris->start[q]);
+    if (!near) return;
+    int32_t count = 0;
+    for (int32_t b = tris->start[q]; b < tris->start[q + 1]; ++b)
+        if (boxes_overlap_by(pbox, s->triangle_boxes + 6 * (size_t)tris->items[b], 0.0))
+            near[count++] = tris->items[b];
+    for (int32_t a = own->start[p]; a < own->start[p + 1] && count; ++a) {
         int32_t v = own->items[a];
         const double *vbox = s->particle_boxes + 6 * (size_t)v;
         if (!boxes_overlap_by(vbox, qbox, h)) continue;
-        for (int32_t b = tris->start[q]; b < tris->start[q + 1]; ++b) {
-            int32_t t = tris->items[b];
+        for (int32_t b = 0; b < count; ++b) {
+            int32_t t = near[b];
             const int32_t *tri = s->triangles + 3 * (size_t)t;
-            if (tri[0] == v || tri[1] == v || tri[2] == v) continue;
-            if (boxes_overlap_by(vbox, s->triangle_boxes + 6 * (size_t)t, 0.0)) slice_push(vf, v, t);
+            const double *tbox = s->triangle_boxes + 6 * (size_t)t;
+            if (tri[0] == v || tri[1] == v || tri[2] == v || !boxes_overlap_by(vbox, tbox, 0.0))
+                continue;
+            if (boxes_overlap_by(vbox, tbox, -h) || !rest_near_vf(s, v, tri, exclude2))
+                slice_push(vf, v, t);
         }
     }
 }
 
 /* Edges of patch p (owned) against edges of patch q (for p == q, each pair
- * once). */
-static void open_ee(const wc_self_state *s, pair_slice *ee, int32_t p, int32_t q, double h)
+ * once), with the same rule. */
+static void open_ee(const wc_self_state *s, pair_slice *ee, int32_t p, int32_t q, double h,
+                    double exclude2)
 {
     const csr *own = &s->patch_owned_edges;
-    const double *qbox = s->patch_boxes + 6 * (size_t)q;
+    const double *pbox = s->patch_boxes + 6 * (size_t)p, *qbox = s->patch_boxes + 6 * (size_t)q;
+    int32_t *near = slice_scratch(ee, own->start[q + 1] - own->start[q]);
+    if (!near) return;
+    int32_t count = 0;
+    for (int32_t b = own->start[q]; b < own->start[q + 1]; ++b)
+        if (boxes_overlap_by(pbox, s->edge_boxes + 6 * (size_t)own->items[b], h))
+            near[count++] = own->items[b];
+    int32_t from = 0;
     for (int32_t a = own->start[p]; a < own->start[p + 1]; ++a) {
         int32_t e = own->items[a];
+        /* p == q: near[] is p's edge list itself; pair each with later ones */
+        if (p == q) from = a - own->start[p] + 1;
         const double *ebox = s->edge_boxes + 6 * (size_t)e;
         if (!boxes_overlap_by(ebox, qbox, h)) continue;
-        int32_t ea = s->edges[2 * (size_t)e], eb = s->edges[2 * (size_t)e + 1];
-        for (int32_t b = p == q ? a + 1 : own->start[q]; b < own->start[q + 1]; ++b) {
-            int32_t f = own->items[b];
-            int32_t fa = s->edges[2 * (size_t)f], fb = s->edges[2 * (size_t)f + 1];
-            if (fa == ea || fa == eb || fb == ea || fb == eb) continue;
-            if (boxes_overlap_by(ebox, s->edge_boxes + 6 * (size_t)f, h)) slice_push(ee, e, f);
+        const int32_t *ev = s->edges + 2 * (size_t)e;
+        for (int32_t b = from; b < count; ++b) {
+            int32_t f = near[b];
+            const int32_t *fv = s->edges + 2 * (size_t)f;
+            if (fv[0] == ev[0] || fv[0] == ev[1] || fv[1] == ev[0] || fv[1] == ev[1]) continue;
+            const double *fbox = s->edge_boxes + 6 * (size_t)f;
+            if (!boxes_overlap_by(ebox, fbox, h)) continue;
+            if (boxes_overlap_by(ebox, fbox, 0.0) || !rest_near_ee(s, ev, fv, exclude2))
+                slice_push(ee, e, f);
         }
     }
 }
 
-/* Concatenates slices in order into one list (with a status byte per pair
- * when status is given). */
-static int gather(const pair_slice *slices, int32_t **pairs, uint8_t **status, int64_t *count,
-                  int64_t *capacity)
+/* Concatenates slices (entries of `stride` ints) in order into one list,
+ * with a zeroed status byte per entry when status is given. */
+static int gather(const pair_slice *slices, int stride, int32_t **pairs, uint8_t **status,
+                  int64_t *count, int64_t *capacity)
 {
     int64_t total = 0;
     for (int k = 0; k < SLICES; ++k) {
@@ -756,7 +844,7 @@ static int gather(const pair_slice *slices, int32_t **pairs, uint8_t **status, i
         int64_t cap = *capacity > 0 ? *capacity : 1024;
         while (cap < total) cap *= 2;
         wc_free(*pairs);
-        *pairs = wc_alloc_array(2 * (size_t)cap, sizeof **pairs);
+        *pairs = wc_alloc_array((size_t)stride * (size_t)cap, sizeof **pairs);
         if (status) {
             wc_free(*status);
             *status = wc_alloc_array((size_t)cap, 1);
@@ -767,7 +855,8 @@ static int gather(const pair_slice *slices, int32_t **pairs, uint8_t **status, i
     int64_t at = 0;
     for (int k = 0; k < SLICES; ++k) {
         if (slices[k].count)
-            memcpy(*pairs + 2 * at, slices[k].pairs, 2 * (size_t)slices[k].count * sizeof **pairs);
+            memcpy(*pairs + stride * at, slices[k].pairs,
+                   (size_t)stride * (size_t)slices[k].count * sizeof **pairs);
         at += slices[k].count;
     }
     *count = total;
@@ -828,46 +917,54 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, double h, doubl
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
     for (int k = 0; k < SLICES; ++k)
         patch_pairs_slice(s, &s->slices[k], slice_begin(np, k), slice_begin(np, k + 1));
-    if (!gather(s->slices, &s->open, NULL, &s->open_count, &s->open_capacity))
+    if (!gather(s->slices, 3, &s->open, NULL, &s->open_count, &s->open_capacity))
         return WC_ERROR_OUT_OF_MEMORY;
-    /* Culling decisions (serial: few), and the pairs to open, compacted. */
+    /* Culling decisions (serial: few): patches alone, neighbours (a flag per
+     * adjacency entry, both ways), patches two apart (triples); the pairs to
+     * open are compacted in place to (P, Q). */
     for (int32_t p = 0; p < np; ++p) s->patch_culled[p] = s->patch_cos[p] > CONE_COS;
     memset(s->adjacent_culled, 0, (size_t)s->patch_adjacent.start[np]);
-    int64_t open = 0;
+    const csr *adj = &s->patch_adjacent;
+    int64_t open = 0, joined = 0;
     for (int64_t k = 0; k < s->open_count; ++k) {
-        int32_t p = s->open[2 * k], q = s->open[2 * k + 1];
-        if (q >= 0) {
+        /* read before the compaction below may overwrite: 2 * open <= 3 k */
+        int32_t p = s->open[3 * k], q = s->open[3 * k + 1], how = s->open[3 * k + 2];
+        if (how == -1) {
             s->open[2 * open] = p, s->open[2 * open + 1] = q, ++open;
-            continue;
+        } else if (how == -2) {
+            int32_t at = sorted_contains(adj->items + adj->start[p], adj->start[p + 1] - adj->start[p], q);
+            int32_t back = sorted_contains(adj->items + adj->start[q], adj->start[q + 1] - adj->start[q], p);
+            s->adjacent_culled[adj->start[p] + at] = 1;
+            s->adjacent_culled[adj->start[q] + back] = 1;
+        } else {
+            if (!grow_int32(&s->joined, &s->joined_capacity, 3 * (joined + 1)))
+                return WC_ERROR_OUT_OF_MEMORY;
+            s->joined[3 * joined] = p, s->joined[3 * joined + 1] = q, s->joined[3 * joined + 2] = how;
+            ++joined;
         }
-        q = ~q;
-        const csr *adj = &s->patch_adjacent;
-        int32_t at = sorted_contains(adj->items + adj->start[p], adj->start[p + 1] - adj->start[p], q);
-        int32_t back = sorted_contains(adj->items + adj->start[q], adj->start[q + 1] - adj->start[q], p);
-        s->adjacent_culled[adj->start[p] + at] = 1;
-        s->adjacent_culled[adj->start[q] + back] = 1;
     }
     s->open_count = open;
+    s->joined_count = joined;
 
     /* Element pairs of the opened patch pairs: vertex-face both ways, then
-     * edge-edge; slices over the opened pairs write vertex-face pairs into
-     * their own buffers and edge-edge pairs into the second half. */
+     * edge-edge. */
+    double exclude2 = (REST_EXCLUSION * h) * (REST_EXCLUSION * h);
     for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (open >= 64)
     for (int k = 0; k < SLICES; ++k)
         for (int64_t m = slice_begin(open, k); m < slice_begin(open, k + 1); ++m) {
             int32_t p = s->open[2 * m], q = s->open[2 * m + 1];
-            open_vf(s, &s->slices[k], p, q, h);
-            if (p != q) open_vf(s, &s->slices[k], q, p, h);
+            open_vf(s, &s->slices[k], p, q, h, exclude2);
+            if (p != q) open_vf(s, &s->slices[k], q, p, h, exclude2);
         }
-    if (!gather(s->slices, &s->vf, &s->vf_status, &s->vf_count, &s->vf_capacity))
+    if (!gather(s->slices, 2, &s->vf, &s->vf_status, &s->vf_count, &s->vf_capacity))
         return WC_ERROR_OUT_OF_MEMORY;
     for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (open >= 64)
     for (int k = 0; k < SLICES; ++k)
         for (int64_t m = slice_begin(open, k); m < slice_begin(open, k + 1); ++m)
-            open_ee(s, &s->slices[k], s->open[2 * m], s->open[2 * m + 1], h);
-    if (!gather(s->slices, &s->ee, &s->ee_status, &s->ee_count, &s->ee_capacity))
+            open_ee(s, &s->slices[k], s->open[2 * m], s->open[2 * m + 1], h, exclude2);
+    if (!gather(s->slices, 2, &s->ee, &s->ee_status, &s->ee_count, &s->ee_capacity))
         return WC_ERROR_OUT_OF_MEMORY;
     return WC_OK;
 }
@@ -1255,8 +1352,16 @@ static int still_valid(wc_self_state *s, const wc_cloth *c)
     for (int32_t p = 0; p < s->patch_count; ++p) {
         if (!s->patch_touched[p]) continue;
         if (s->patch_culled[p] && !(s->patch_cos[p] > CONE_COS)) return 0;
-        for (int32_t k = adj->start[p]; k < adj->start[p + 1]; ++k)
-            if (s->adjacent_culled[k] && !cones_join(s, p, adj->items[k])) return 0;
+        for (int32_t k = adj->start[p]; k < adj->start[p + 1]; ++k) {
+            int32_t two[2] = {p, adj->items[k]};
+            if (s->adjacent_culled[k] && !cones_fit(s, two, 2)) return 0;
+        }
+    }
+    for (int64_t k = 0; k < s->joined_count; ++k) {
+        const int32_t *three = s->joined + 3 * k;
+        if ((s->patch_touched[three[0]] || s->patch_touched[three[1]] || s->patch_touched[three[2]]) &&
+            !cones_fit(s, three, 3))
+            return 0;
     }
     return 1;
 }

@@ -11,6 +11,7 @@
 #include "parallel.h"
 #include "selfcollide.h"
 #include "status.h"
+#include "wetness.h"
 
 int32_t wc_version(void) { return WC_VERSION; }
 
@@ -128,6 +129,9 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
                            (int)k);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_cloth *cl = w->cloths[c];
+        /* this step's contacts replace the last step's, which wet friction
+         * and the stuck test still need */
+        memcpy(cl->contact_prev, cl->contact, (size_t)cl->particle_count);
         memset(cl->contact, 0, (size_t)cl->particle_count);
         memset(cl->history_override, 0, (size_t)cl->particle_count);
         /* Particles against collider faces, then collider vertices and edges
@@ -166,17 +170,20 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
     return WC_OK;
 }
 
-/* One step of the whole world, top to bottom: forces, integration,
- * collisions (with colliders, then each cloth with itself), then the
- * commit. (The wet response joins after the collisions.) Nothing is
- * committed unless every cloth's new state is finite, so a failed step
+/* One step of the whole world, top to bottom: forces (with the wet pull of
+ * the last step's contacts), integration, collisions (with colliders, then
+ * each cloth with itself; wet friction acts in their response), the wet
+ * response (stuck particles), the commit, and the wetness dynamics. Nothing
+ * is committed unless every cloth's new state is finite, so a failed step
  * leaves the world exactly as it was. */
 static wc_status world_step(wc_world *w, double dt, double share, double pin_fraction)
 {
     int threads = wc_thread_count(w->def.thread_count);
     memset(&w->stats, 0, sizeof w->stats);
-    for (int32_t c = 0; c < w->cloth_count; ++c)
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_forces_compute(w->cloths[c], w->def.gravity, threads);
+        if (w->cloths[c]->wet_forces) wc_wet_forces(w->cloths[c], threads);
+    }
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         int32_t bad = wc_integrate_verlet(w->cloths[c], dt, pin_fraction, threads);
         if (bad >= 0) return non_finite_error(w, dt, c, bad, "integration");
@@ -186,8 +193,15 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
         wc_status s = collide(w, dt, share, threads);
         if (s) return s;
     }
+    if (colliding)
+        for (int32_t c = 0; c < w->cloth_count; ++c)
+            w->stats.stuck_particles += wc_wet_mark_stuck(w->cloths[c]);
     for (int32_t c = 0; c < w->cloth_count; ++c) wc_cloth_commit(w->cloths[c], dt, colliding);
     for (int32_t k = 0; k < w->collider_count; ++k) wc_collider_end_step(w->colliders[k]);
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
+        const wc_material *m = &w->cloths[c]->material;
+        if (m->wicking > 0.0 || m->drying > 0.0) wc_wet_update(w->cloths[c], dt);
+    }
     w->time += dt;
     return WC_OK;
 }
@@ -270,6 +284,6 @@ int32_t wc_world_cloth_count(const wc_world *w) { return w ? w->cloth_count : 0;
 
 wc_step_stats wc_world_get_stats(const wc_world *w)
 {
-    wc_step_stats none = {0, 0, 0};
+    wc_step_stats none = {0, 0, 0, 0};
     return w ? w->stats : none;
 }

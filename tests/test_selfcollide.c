@@ -156,7 +156,7 @@ static void test_vertex_face(void)
     set_end(c, 5, -0.3, 0.1, 0.35);
     clear_contacts(c);
     CHECK(count_ccd_collisions(c, 1e-9) > 0, "setup: the apex should pass through A");
-    wc_step_stats stats = {0, 0, 0};
+    wc_step_stats stats = {0, 0, 0, 0};
     wc_status s = wc_self_collide(c, 0.01, 1, &stats);
     CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
     double p[3], a[3], b[3], q[3], bary[3];
@@ -205,7 +205,7 @@ static void test_edge_edge(void)
     for (int32_t i = 0; i < 6; ++i) set_end(c, i, c->x[i], c->y[i], c->z[i] - (i >= 3 ? 0.2 : 0.0));
     clear_contacts(c);
     CHECK(count_ccd_collisions(c, 1e-9) > 0, "setup: the edges should cross");
-    wc_step_stats stats = {0, 0, 0};
+    wc_step_stats stats = {0, 0, 0, 0};
     wc_status s = wc_self_collide(c, 0.01, 1, &stats);
     CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
     double p0[3], p1[3], q0[3], q1[3], u, v;
@@ -245,7 +245,7 @@ static void test_pinned_face(void)
     for (int32_t i = 0; i < 6; ++i) set_end(c, i, c->x[i], c->y[i], c->z[i]);
     set_end(c, 3, 0.0, 0.0, -0.15);
     clear_contacts(c);
-    wc_step_stats stats = {0, 0, 0};
+    wc_step_stats stats = {0, 0, 0, 0};
     wc_self_collide(c, 0.01, 1, &stats);
     for (int32_t i = 0; i < 3; ++i)
         CHECK(c->nx[i] == c->x[i] && c->ny[i] == c->y[i] && c->nz[i] == c->z[i],
@@ -311,7 +311,7 @@ static void test_failsafe(void)
     }
     clear_contacts(c);
     int32_t before = count_ccd_collisions(c, 1e-9);
-    wc_step_stats stats = {0, 0, 0};
+    wc_step_stats stats = {0, 0, 0, 0};
     wc_status s = wc_self_collide(c, 0.01, 1, &stats);
     CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
     int32_t after = count_ccd_collisions(c, 1e-9);
@@ -372,13 +372,13 @@ static void test_threads(void)
     const int size = 80; /* 6400 particles: above WC_PARALLEL_MIN */
     double *ref = NULL;
     size_t n = 0;
-    wc_step_stats ref_stats = {0, 0, 0};
+    wc_step_stats ref_stats = {0, 0, 0, 0};
     int thread_counts[3] = {1, 2, 4};
     for (int r = 0; r < 3; ++r) {
         wc_world *w = crumpled(size, thread_counts[r], 0.004);
         wc_cloth *c = w->cloths[0];
         n = (size_t)c->particle_count;
-        wc_step_stats stats = {0, 0, 0};
+        wc_step_stats stats = {0, 0, 0, 0};
         wc_status s = wc_self_collide(c, 0.001, thread_counts[r], &stats);
         CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
         /* Everything the call writes, as bits. */
