@@ -111,7 +111,7 @@ wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double c
         }
         wc_free(g->large);
         g->large = large ? wc_alloc_array((size_t)large, sizeof *g->large) : NULL;
-        if (!g->items || (large && !g->large)) return WC_ERROR_OUT_OF_MEMORY;
+        if ((entries && !g->items) || (large && !g->large)) return WC_ERROR_OUT_OF_MEMORY;
     }
     int32_t *fill = wc_alloc_array((size_t)buckets, sizeof *fill);
     if (!fill) return WC_ERROR_OUT_OF_MEMORY;
