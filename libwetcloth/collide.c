@@ -80,6 +80,23 @@ static wc_status mesh_begin_step(wc_collider *c, double share)
     double cell = extent / c->triangle_count;
     if (!(cell > 1e-9)) cell = 1e-9;
     wc_status s = wc_grid_build(&c->grid, c->boxes, c->triangle_count, cell);
+    /* Vertices and edges get grids of their own for the feature pass. */
+    for (int32_t v = 0; v < c->vertex_count && !s; ++v) {
+        double *box = c->vertex_boxes + 6 * (size_t)v, p[3];
+        empty_box(box);
+        corner(c->current, v, p), grow_box(box, p);
+        corner(c->next, v, p), grow_box(box, p);
+    }
+    for (int32_t e = 0; e < c->edge_count && !s; ++e) {
+        double *box = c->edge_boxes + 6 * (size_t)e, p[3];
+        empty_box(box);
+        for (int k = 0; k < 2; ++k) {
+            corner(c->current, c->edges[2 * e + k], p), grow_box(box, p);
+            corner(c->next, c->edges[2 * e + k], p), grow_box(box, p);
+        }
+    }
+    if (!s) s = wc_grid_build(&c->vertex_grid, c->vertex_boxes, c->vertex_count, cell);
+    if (!s) s = wc_grid_build(&c->edge_grid, c->edge_boxes, c->edge_count, cell);
     c->grid_static = !c->moving && s == WC_OK;
     return s;
 }

@@ -360,28 +360,27 @@ static int edge_edge(wc_cloth *c, wc_feature_state *s, int32_t e, const double p
 /* One pass                                                                 */
 /* ------------------------------------------------------------------------ */
 
-/* The collider triangles whose boxes overlap `box`, ascending, into s->found
- * (grown when needed). -1 on out-of-memory. */
-static int32_t candidates(wc_feature_state *s, const wc_collider *col, const double box[6])
+/* The items of one of the collider's feature grids whose boxes overlap
+ * `box`, ascending, into s->found (grown when needed). -1 on out-of-memory. */
+static int32_t candidates(wc_feature_state *s, const wc_grid *grid, const double box[6])
 {
-    int32_t n = wc_grid_query(&col->grid, box, s->found, s->found_capacity);
+    int32_t n = wc_grid_query(grid, box, s->found, s->found_capacity);
     if (n <= s->found_capacity) return n;
     int32_t *grown = wc_alloc_array((size_t)n, 2 * sizeof *grown);
     if (!grown) return -1;
     wc_free(s->found);
     s->found = grown;
     s->found_capacity = 2 * n;
-    return wc_grid_query(&col->grid, box, s->found, s->found_capacity);
+    return wc_grid_query(grid, box, s->found, s->found_capacity);
 }
 
 /* One pass of a collider against the cloth, from the cloth's side: each
- * cloth triangle near the collider asks the collider's grid (built once for
- * a static collider) for the collider triangles near it, whose vertices it
- * is tested against; each cloth edge likewise against their edges. Stamps
- * keep a vertex or edge from being tested twice for one element. Returns 1
- * if anything moved, 0 if not, -1 on out-of-memory. */
-static int collider_pass(wc_cloth *c, wc_feature_state *s, wc_collider *col, double r, double mu,
-                         double dt)
+ * cloth triangle near the collider asks the collider's vertex grid (built
+ * once for a static collider) for the vertices near it, each cloth edge its
+ * edge grid for the edges near it. Returns 1 if anything moved, 0 if not,
+ * -1 on out-of-memory. */
+static int collider_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col, double r,
+                         double mu, double dt)
 {
     int moved = 0;
     if (!wc_boxes_overlap(col->bounds, s->bounds)) return 0;
@@ -390,19 +389,14 @@ static int collider_pass(wc_cloth *c, wc_feature_state *s, wc_collider *col, dou
         const int32_t *tri = c->topology.triangles + 3 * (size_t)t;
         if (s->only_moved && !(s->moved[tri[0]] | s->moved[tri[1]] | s->moved[tri[2]])) continue;
         if (!wc_boxes_overlap(box, col->bounds)) continue;
-        int32_t n = candidates(s, col, box);
+        int32_t n = candidates(s, &col->vertex_grid, box);
         if (n < 0) return -1;
-        ++col->stamp;
-        for (int32_t k = 0; k < n; ++k)
-            for (int j = 0; j < 3; ++j) {
-                int32_t v = col->triangles[3 * (size_t)s->found[k] + j];
-                if (col->vertex_stamp[v] == col->stamp) continue;
-                col->vertex_stamp[v] = col->stamp;
-                double v0[3], v1[3];
-                vertex_of(col->current, v, v0);
-                vertex_of(col->next, v, v1);
-                moved |= vertex_triangle(c, s, t, v0, v1, r, mu, dt);
-            }
+        for (int32_t k = 0; k < n; ++k) {
+            double v0[3], v1[3];
+            vertex_of(col->current, s->found[k], v0);
+            vertex_of(col->next, s->found[k], v1);
+            moved |= vertex_triangle(c, s, t, v0, v1, r, mu, dt);
+        }
     }
     for (int32_t e = 0; e < s->edge_count; ++e) {
         double a0[3], a1[3], b0[3], b1[3], box[6];
@@ -412,21 +406,17 @@ static int collider_pass(wc_cloth *c, wc_feature_state *s, wc_collider *col, dou
         const double *ends[4] = {a0, a1, b0, b1};
         feature_box(ends, 4, r, box);
         if (!wc_boxes_overlap(box, col->bounds)) continue;
-        int32_t n = candidates(s, col, box);
+        int32_t n = candidates(s, &col->edge_grid, box);
         if (n < 0) return -1;
-        ++col->stamp;
-        for (int32_t k = 0; k < n; ++k)
-            for (int j = 0; j < 3; ++j) {
-                int32_t id = col->triangle_edges[3 * (size_t)s->found[k] + j];
-                if (id < 0 || col->edge_stamp[id] == col->stamp) continue;
-                col->edge_stamp[id] = col->stamp;
-                double p0[3], p1[3], q0[3], q1[3];
-                vertex_of(col->current, col->edges[2 * id], p0);
-                vertex_of(col->next, col->edges[2 * id], p1);
-                vertex_of(col->current, col->edges[2 * id + 1], q0);
-                vertex_of(col->next, col->edges[2 * id + 1], q1);
-                moved |= edge_edge(c, s, e, p0, p1, q0, q1, box, r, mu, dt);
-            }
+        for (int32_t k = 0; k < n; ++k) {
+            int32_t id = s->found[k];
+            double p0[3], p1[3], q0[3], q1[3];
+            vertex_of(col->current, col->edges[2 * id], p0);
+            vertex_of(col->next, col->edges[2 * id], p1);
+            vertex_of(col->current, col->edges[2 * id + 1], q0);
+            vertex_of(col->next, col->edges[2 * id + 1], q1);
+            moved |= edge_edge(c, s, e, p0, p1, q0, q1, box, r, mu, dt);
+        }
     }
     return moved;
 }
@@ -447,7 +437,7 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
         memset(s->moving, 0, (size_t)c->particle_count);
         moved = 0;
         for (int32_t k = 0; k < count; ++k) {
-            wc_collider *col = colliders[k];
+            const wc_collider *col = colliders[k];
             if (!col->is_mesh) continue;
             double r = fmax(h + col->thickness, 1e-6);
             int result = collider_pass(c, s, col, r, sqrt(c->material.friction * col->friction), dt);

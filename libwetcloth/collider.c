@@ -41,8 +41,10 @@ void wc_collider_destroy(wc_collider *c)
     wc_free(c->triangles);
     wc_free(c->edges);
     wc_free(c->triangle_edges);
-    wc_free(c->vertex_stamp);
-    wc_free(c->edge_stamp);
+    wc_free(c->vertex_boxes);
+    wc_free(c->edge_boxes);
+    wc_grid_free(&c->vertex_grid);
+    wc_grid_free(&c->edge_grid);
     wc_free(c->current);
     wc_free(c->target);
     wc_free(c->next);
@@ -71,9 +73,9 @@ static int build_edges(wc_collider *c)
     int32_t *entries = wc_alloc_array(3 * n, sizeof *entries);
     c->edges = wc_alloc_array(2 * n, sizeof *c->edges);
     c->triangle_edges = wc_alloc_array(n, sizeof *c->triangle_edges);
-    c->vertex_stamp = wc_alloc_array((size_t)c->vertex_count, sizeof *c->vertex_stamp);
-    c->edge_stamp = wc_alloc_array(n, sizeof *c->edge_stamp);
-    if (!entries || !c->edges || !c->triangle_edges || !c->vertex_stamp || !c->edge_stamp) {
+    c->vertex_boxes = wc_alloc_array(6 * (size_t)c->vertex_count, sizeof *c->vertex_boxes);
+    c->edge_boxes = wc_alloc_array(6 * n, sizeof *c->edge_boxes);
+    if (!entries || !c->edges || !c->triangle_edges || !c->vertex_boxes || !c->edge_boxes) {
         wc_free(entries);
         return 0;
     }
@@ -177,6 +179,8 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
         c->vertex_count = d->vertex_count;
         c->triangle_count = d->triangle_count;
         wc_grid_init(&c->grid);
+        wc_grid_init(&c->vertex_grid);
+        wc_grid_init(&c->edge_grid);
         c->triangles = wc_alloc_array(3 * nt, sizeof *c->triangles);
         c->current = wc_alloc_array(nv, sizeof *c->current);
         c->target = wc_alloc_array(nv, sizeof *c->target);
@@ -210,6 +214,8 @@ wc_status wc_world_add_convex_collider(wc_world *w, const wc_convex_collider_def
     wc_collider *c = wc_alloc_array(1, sizeof *c);
     if (!c) return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
     wc_grid_init(&c->grid);
+    wc_grid_init(&c->vertex_grid);
+    wc_grid_init(&c->edge_grid);
     wc_status s = wc_convex_shape_init(&c->convex, &c->pose_current, d, &w->error);
     if (s) {
         wc_collider_destroy(c);

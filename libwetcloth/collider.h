@@ -45,11 +45,13 @@ typedef struct wc_collider {
     int32_t edge_count;
     int32_t *edges;
     int32_t *triangle_edges;
-    /// Scratch for the feature pass (collide_features.c): the last query
-    /// that listed each vertex and edge, so each is tested once per query.
-    int64_t *vertex_stamp;
-    int64_t *edge_stamp;
-    int64_t stamp;
+    /// Boxes of the vertices and edges over the step (current and next
+    /// positions) and their grids, for the feature pass (collide_features.c);
+    /// rebuilt with the triangle grid, so never for a static collider.
+    double *vertex_boxes;
+    double *edge_boxes;
+    wc_grid vertex_grid;
+    wc_grid edge_grid;
     /// Vertex positions now, xyz per vertex.
     double *current;
     /// Vertex positions at the end of the running advance.

@@ -1420,9 +1420,14 @@ static wc_status failsafe(wc_cloth *c, wc_self_state *s, self_ctx *ctx, double g
 
 #ifdef WC_SELF_PROFILE
 #include <stdio.h>
-static long prof_calls, prof_open, prof_vf, prof_ee, prof_passes, prof_rebuilds, prof_np, prof_culled;
+#include <omp.h>
+static long prof_calls, prof_open, prof_vf, prof_ee, prof_passes, prof_rebuilds, prof_np, prof_culled, prof_reverted;
+static double prof_t_total, prof_t_broad, prof_t_eval, prof_t_respond, prof_t_fail;
 static void prof_report(void)
 {
+    if (prof_calls)
+        fprintf(stderr, "self time: total %.3f s, broadphase %.3f, evaluate %.3f, respond %.3f, failsafe %.3f; reverted %ld\n",
+                prof_t_total, prof_t_broad, prof_t_eval, prof_t_respond, prof_t_fail, prof_reverted);
     if (prof_calls)
         fprintf(stderr, "self: %ld calls; per call: patches %.0f culled %.0f open %.1f vf %.1f ee %.1f passes %.2f rebuilds %.3f\n",
                 prof_calls, (double)prof_np / prof_calls, (double)prof_culled / prof_calls, (double)prof_open / prof_calls,
@@ -1447,9 +1452,17 @@ wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *st
     double g = BOX_MARGIN * ctx.h;
     int32_t marked = 0, reverted = 0;
     int rebuild = 1;
+#ifdef WC_SELF_PROFILE
+    double t_start = omp_get_wtime(), t0;
+#define PROF_T(acc, stmt) (t0 = omp_get_wtime(), stmt, acc += omp_get_wtime() - t0)
+#else
+#define PROF_T(acc, stmt) (stmt)
+#endif
     for (int pass = 0;; ++pass) {
         if (rebuild) {
-            if (broadphase(s, c, ctx.h, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+            wc_status bs;
+            PROF_T(prof_t_broad, bs = broadphase(s, c, ctx.h, g, threads));
+            if (bs) return WC_ERROR_OUT_OF_MEMORY;
             memset(s->dirty, 1, (size_t)s->particle_count);
         }
         int last = pass >= SELF_PASSES;
@@ -1462,11 +1475,19 @@ wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *st
         }
         if (pass) prof_calls--;
 #endif
-        evaluate(s, &ctx, last, threads);
-        if (last || !respond_all(c, s, &ctx, &marked)) break;
-        rebuild = !still_valid(s, c);
+        PROF_T(prof_t_eval, evaluate(s, &ctx, last, threads));
+        int moved = 0;
+        if (!last) PROF_T(prof_t_respond, moved = respond_all(c, s, &ctx, &marked));
+        if (last || !moved) break;
+        PROF_T(prof_t_respond, rebuild = !still_valid(s, c));
     }
-    if (failsafe(c, s, &ctx, g, threads, &reverted)) return WC_ERROR_OUT_OF_MEMORY;
+    wc_status fs;
+    PROF_T(prof_t_fail, fs = failsafe(c, s, &ctx, g, threads, &reverted));
+    if (fs) return WC_ERROR_OUT_OF_MEMORY;
+#ifdef WC_SELF_PROFILE
+    prof_t_total += omp_get_wtime() - t_start;
+    prof_reverted += reverted;
+#endif
     if (stats) {
         stats->cloth_contacts += marked;
         stats->failsafe_particles += reverted;
