@@ -860,7 +860,7 @@ static int gather(const pair_slice *slices, int stride, int32_t **pairs, uint8_t
         at += slices[k].count;
     }
     *count = total;
-    if (status) memset(*status, 0, (size_t)total);
+    if (status && total) memset(*status, 0, (size_t)total); /* *status is NULL until a pair is found */
     return 1;
 }
 
