@@ -1,5 +1,7 @@
 #include "scenes.h"
 
+#include "primitives.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -111,4 +113,25 @@ uint64_t scene_hash_positions(const wc_world *w, int32_t cloth)
     }
     free(p);
     return h;
+}
+
+int scene_count_near_sphere(const wc_world *w, int32_t cloth, double radius, double within)
+{
+    double v[3 * 114], bary[3];
+    int32_t t[3 * 224], nt, near = 0, n = wc_cloth_particle_count(w, cloth);
+    double *p = malloc(3 * sizeof(double) * (size_t)n);
+    if (!p) return -1;
+    scene_uv_sphere(radius, 16, 8, v, t, &nt);
+    wc_cloth_get_positions(w, cloth, p, n);
+    for (int32_t i = 0; i < n; ++i) {
+        double best = INFINITY;
+        for (int32_t k = 0; k < nt; ++k) {
+            double d = wc_point_triangle_closest(p + 3 * i, v + 3 * t[3 * k], v + 3 * t[3 * k + 1],
+                                                 v + 3 * t[3 * k + 2], bary);
+            if (d < best) best = d;
+        }
+        near += sqrt(best) < within;
+    }
+    free(p);
+    return near;
 }

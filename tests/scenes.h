@@ -30,6 +30,11 @@ int32_t scene_add_plate(wc_world *world, const double center[3], const double u[
 void scene_plate_vertices(const double center[3], const double u[3], const double v[3],
                           double size, double out[12]);
 
+/// Particles of a cloth within `within` (m) of the surface of the thesis'
+/// UV sphere (16 x 8, `radius`, at the origin), by brute force over its
+/// triangles: independent of the solver's broadphase.
+int scene_count_near_sphere(const wc_world *world, int32_t cloth, double radius, double within);
+
 /// FNV-1a hash of a cloth's positions (bitwise).
 uint64_t scene_hash_positions(const wc_world *world, int32_t cloth);
 

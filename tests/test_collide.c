@@ -211,24 +211,6 @@ static void fast_plate(void)
     wc_world_destroy(w);
 }
 
-/* Particles within `within` of the thesis sphere's surface, by brute force
- * over its triangles (independent of the solver's broadphase). */
-static int near_sphere(const wc_world *w, int32_t cloth, double radius, double within)
-{
-    double v[3 * 114], p[3 * 400], bary[3];
-    int32_t t[3 * 224], nt, near = 0, n = wc_cloth_particle_count(w, cloth);
-    scene_uv_sphere(radius, 16, 8, v, t, &nt);
-    wc_cloth_get_positions(w, cloth, p, n);
-    for (int32_t i = 0; i < n; ++i) {
-        double best = INFINITY;
-        for (int32_t k = 0; k < nt; ++k)
-            best = fmin(best, wc_point_triangle_closest(p + 3 * i, v + 3 * t[3 * k], v + 3 * t[3 * k + 1],
-                                                        v + 3 * t[3 * k + 2], bary));
-        near += sqrt(best) < within;
-    }
-    return near;
-}
-
 /* The thesis scene: a 20 x 20 grid cloth 0.6 m above the 114-vertex UV
  * sphere (radius 0.3 m), 48 frames at 24 fps. No intersection at any frame,
  * and at the end the cloth lies on the sphere: more than 50 of its 400
@@ -251,7 +233,7 @@ static void thesis_scene(void)
         CHECK(wc_world_count_intersections(w, &counts) == WC_OK, "%s", wc_world_last_error(w));
         total += counts.cloth_cloth + counts.cloth_collider;
     }
-    int near = near_sphere(w, cl, 0.3, 2 * g.material.thickness);
+    int near = scene_count_near_sphere(w, cl, 0.3, 2 * g.material.thickness);
     printf("thesis scene: %d intersections over 48 frames, %d particles within %.0f mm of the "
            "sphere at the end\n", total, near, 2e3 * g.material.thickness);
     CHECK(total == 0, "%d intersections", total);

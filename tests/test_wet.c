@@ -78,26 +78,6 @@ static int intersections(const wc_world *w)
     return c.cloth_cloth + c.cloth_collider;
 }
 
-/* Particles within `within` of the thesis sphere's surface, by brute force
- * over its triangles (independent of the solver). */
-static int near_sphere(const wc_world *w, int32_t cloth, double radius, double within)
-{
-    double v[3 * 114], bary[3];
-    int32_t t[3 * 224], nt, near = 0, n = wc_cloth_particle_count(w, cloth);
-    double *p = malloc(3 * sizeof(double) * (size_t)n);
-    scene_uv_sphere(radius, 16, 8, v, t, &nt);
-    wc_cloth_get_positions(w, cloth, p, n);
-    for (int32_t i = 0; i < n; ++i) {
-        double best = INFINITY;
-        for (int32_t k = 0; k < nt; ++k)
-            best = fmin(best, wc_point_triangle_closest(p + 3 * i, v + 3 * t[3 * k], v + 3 * t[3 * k + 1],
-                                                        v + 3 * t[3 * k + 2], bary));
-        near += sqrt(best) < within;
-    }
-    free(p);
-    return near;
-}
-
 /* ------------------------------------------------------------------------ */
 /* 1. Dry is exactly the plain model                                        */
 /* ------------------------------------------------------------------------ */
@@ -182,7 +162,7 @@ static wrap_result wrap_run(double wetness)
         if (f > 24) r.edge_radius += edge / 24;
         r.edge_final = edge;
     }
-    r.near = near_sphere(w, cl, 0.3, 0.01);
+    r.near = scene_count_near_sphere(w, cl, 0.3, 0.01);
     r.stuck = count_stuck(w, cl);
     wc_world_destroy(w);
     return r;
