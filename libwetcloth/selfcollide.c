@@ -84,6 +84,9 @@
  * edge lengths, split into connected pieces of at most PATCH_MAX triangles. */
 #define PATCH_CELL_EDGES 4.0
 #define PATCH_MAX 64
+/* After the first pass, proximity corrections smaller than this fraction of
+ * the thickness are left alone: they would only buy more passes. */
+#define RESIDUAL 1e-3
 /* The continuous test counts a coplanarity as a collision when the two
  * elements are within this fraction of the thickness. */
 #define CCD_TOLERANCE 0.01
@@ -94,9 +97,16 @@
 typedef struct pair_slice {
     int32_t *pairs;
     int64_t count, capacity;
+    /// One double per pair where the pairs carry one (vertex-face: the
+    /// pair's thickness).
+    double *values;
+    int64_t value_capacity;
     int32_t *query;
     int32_t query_capacity;
     int failed;
+    /* Slices sit side by side and are written by different threads: keep
+     * each one's fields off its neighbours' cache lines. */
+    char pad[64];
 } pair_slice;
 
 /* Compressed lists: the items of list k are items[start[k] .. start[k+1]). */
@@ -115,8 +125,9 @@ struct wc_self_state {
     int32_t *triangle_edges;
     /// Lowest-index triangle holding each edge.
     int32_t *edge_owner;
-    /// Rest shape (positions at creation), xyz per particle.
-    double *rest;
+    /// Rest shape (positions at creation), xyz per particle, and the boxes of
+    /// the triangles and edges in it.
+    double *rest, *rest_triangle_boxes, *rest_edge_boxes;
     double mean_edge;
 
     /* Patches (built once). */
@@ -155,9 +166,16 @@ struct wc_self_state {
     int32_t *vf, *ee;
     uint8_t *vf_status, *ee_status;
     int64_t vf_count, vf_capacity, ee_count, ee_capacity;
+    /// Thickness of each vertex-face pair (see pair_thickness).
+    double *vf_h;
+    int64_t vf_h_capacity;
     /// Per particle: moved since its pairs were last evaluated; put back by
     /// the fail-safe.
     uint8_t *dirty, *reverted;
+    /// Whether the candidates were built (for the thickness built_h): a step
+    /// whose motion stays inside the boxes and keeps the culling reuses them.
+    int built;
+    double built_h;
 };
 
 /* ------------------------------------------------------------------------ */
@@ -524,6 +542,8 @@ wc_self_state *wc_self_state_create(const wc_cloth *c)
         return NULL;
     }
     size_t np = (size_t)s->patch_count, adjacency = (size_t)s->patch_adjacent.start[np];
+    s->rest_triangle_boxes = wc_alloc_array(6 * nt, sizeof *s->rest_triangle_boxes);
+    s->rest_edge_boxes = wc_alloc_array(6 * (size_t)s->edge_count, sizeof *s->rest_edge_boxes);
     s->particle_boxes = wc_alloc_array(6 * n, sizeof *s->particle_boxes);
     s->triangle_boxes = wc_alloc_array(6 * nt, sizeof *s->triangle_boxes);
     s->edge_boxes = wc_alloc_array(6 * (size_t)s->edge_count, sizeof *s->edge_boxes);
@@ -539,9 +559,24 @@ wc_self_state *wc_self_state_create(const wc_cloth *c)
     s->reverted = wc_alloc_array(n, 1);
     if (!s->particle_boxes || !s->triangle_boxes || !s->edge_boxes || !s->triangle_normals ||
         !s->patch_boxes || !s->patch_grown || !s->patch_axis || !s->patch_cos ||
-        !s->patch_culled || !s->patch_touched || !s->adjacent_culled || !s->dirty || !s->reverted) {
+        !s->patch_culled || !s->patch_touched || !s->adjacent_culled || !s->dirty || !s->reverted ||
+        !s->rest_triangle_boxes || !s->rest_edge_boxes) {
         wc_self_state_destroy(s);
         return NULL;
+    }
+    for (size_t t = 0; t < nt; ++t) {
+        double *box = s->rest_triangle_boxes + 6 * t;
+        for (int j = 0; j < 3; ++j) {
+            const double *r = s->rest + 3 * (size_t)s->triangles[3 * t + j];
+            double point[6] = {r[0], r[1], r[2], r[0], r[1], r[2]};
+            if (j == 0) memcpy(box, point, sizeof point);
+            else union_box(box, point);
+        }
+    }
+    for (size_t e = 0; e < (size_t)s->edge_count; ++e) {
+        const double *a = s->rest + 3 * (size_t)s->edges[2 * e], *b = s->rest + 3 * (size_t)s->edges[2 * e + 1];
+        double *box = s->rest_edge_boxes + 6 * e;
+        for (int k = 0; k < 3; ++k) box[k] = min2(a[k], b[k]), box[k + 3] = max2(a[k], b[k]);
     }
     return s;
 }
@@ -549,11 +584,12 @@ wc_self_state *wc_self_state_create(const wc_cloth *c)
 void wc_self_state_destroy(wc_self_state *s)
 {
     if (!s) return;
-    void *blocks[] = {s->edges, s->triangle_edges, s->edge_owner, s->rest, s->triangle_patch,
+    void *blocks[] = {s->edges, s->triangle_edges, s->edge_owner, s->rest, s->rest_triangle_boxes,
+                      s->rest_edge_boxes, s->triangle_patch,
                       s->particle_boxes, s->triangle_boxes, s->edge_boxes, s->triangle_normals,
                       s->patch_boxes, s->patch_grown, s->patch_axis, s->patch_cos,
                       s->patch_culled, s->adjacent_culled, s->patch_touched, s->open, s->joined, s->vf,
-                      s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted};
+                      s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted, s->vf_h};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
     csr_free(&s->patch_triangles);
     csr_free(&s->patch_particles);
@@ -563,6 +599,7 @@ void wc_self_state_destroy(wc_self_state *s)
     wc_grid_free(&s->patch_grid);
     for (int k = 0; k < SLICES; ++k) {
         wc_free(s->slices[k].pairs);
+        wc_free(s->slices[k].values);
         wc_free(s->slices[k].query);
     }
     wc_free(s);
@@ -734,6 +771,26 @@ static void slice_push(pair_slice *sl, int32_t a, int32_t b)
     sl->count++;
 }
 
+/* Sets the value of the slice's last pair. */
+static void slice_value(pair_slice *sl, double value)
+{
+    if (sl->failed) return;
+    if (sl->count > sl->value_capacity) {
+        int64_t cap = sl->value_capacity > 0 ? sl->value_capacity : 256;
+        while (cap < sl->count) cap *= 2;
+        double *p = wc_alloc_array((size_t)cap, sizeof *p);
+        if (!p) {
+            sl->failed = 1;
+            return;
+        }
+        if (sl->value_capacity > 0) memcpy(p, sl->values, (size_t)sl->value_capacity * sizeof *p);
+        wc_free(sl->values);
+        sl->values = p;
+        sl->value_capacity = cap;
+    }
+    sl->values[sl->count - 1] = value;
+}
+
 /* Scratch list of the slice (its query buffer, free once the patch pairs
  * are known), grown to hold `count` items; NULL on out-of-memory. */
 static int32_t *slice_scratch(pair_slice *sl, int32_t count)
@@ -749,31 +806,56 @@ static int32_t *slice_scratch(pair_slice *sl, int32_t count)
     return sl->query;
 }
 
-/* Whether two elements were within the exclusion distance in the rest
- * shape: such pairs only need the continuous test (no proximity). */
-static int rest_near_vf(const wc_self_state *s, int32_t v, const int32_t *tri, double exclude2)
+typedef struct self_ctx {
+    const double *x, *y, *z, *nx, *ny, *nz;
+    const double *rest;
+    /// Thickness, CCD tolerance, squared rest distance below which a pair
+    /// counts as neighbours (see pair_thickness).
+    double h, tol, exclude2;
+} self_ctx;
+
+enum { NO_CONTACT = 0, PROXIMITY = 1, COLLISION = 2 };
+
+/* The thickness a pair keeps: h, except for pairs that were within
+ * REST_EXCLUSION * h in the rest shape (neighbours in the cloth itself, such
+ * as across a quad's diagonal). Those keep half their rest distance, so the
+ * repulsion never fights the cloth's own links yet still holds the two sides
+ * of a tight crease apart; never less than a few CCD tolerances, so that a
+ * pair held apart is not a collision for the continuous test. */
+static double pair_thickness(const self_ctx *ctx, double rest2)
 {
-    double bary[3];
-    return wc_point_triangle_closest(s->rest + 3 * (size_t)v, s->rest + 3 * (size_t)tri[0],
-                                     s->rest + 3 * (size_t)tri[1], s->rest + 3 * (size_t)tri[2],
-                                     bary) < exclude2;
+    if (!(rest2 < ctx->exclude2)) return ctx->h;
+    double t = 0.5 * sqrt(rest2);
+    if (t > ctx->h) t = ctx->h;
+    if (t < 4.0 * ctx->tol) t = 4.0 * ctx->tol;
+    return t;
 }
 
-static int rest_near_ee(const wc_self_state *s, const int32_t *e, const int32_t *f, double exclude2)
+static double rest2_vf(const self_ctx *ctx, const int32_t ids[4])
+{
+    double bary[3];
+    const double *r = ctx->rest;
+    return wc_point_triangle_closest(r + 3 * (size_t)ids[0], r + 3 * (size_t)ids[1],
+                                     r + 3 * (size_t)ids[2], r + 3 * (size_t)ids[3], bary);
+}
+
+static double rest2_ee(const self_ctx *ctx, const int32_t ids[4])
 {
     double u, v;
-    return wc_segment_segment_closest(s->rest + 3 * (size_t)e[0], s->rest + 3 * (size_t)e[1],
-                                      s->rest + 3 * (size_t)f[0], s->rest + 3 * (size_t)f[1], &u,
-                                      &v) < exclude2;
+    const double *r = ctx->rest;
+    return wc_segment_segment_closest(r + 3 * (size_t)ids[0], r + 3 * (size_t)ids[1],
+                                      r + 3 * (size_t)ids[2], r + 3 * (size_t)ids[3], &u, &v);
 }
 
 /* Vertices of patch p (owned) against triangles of patch q: pairs whose
- * boxes meet, or meet within h when they were not neighbours at rest. */
-static void open_vf(const wc_self_state *s, pair_slice *vf, int32_t p, int32_t q, double h,
-                    double exclude2)
+ * boxes meet within the pair's thickness (see pair_thickness; the rest
+ * boxes spare computing rest distances for pairs that were far apart). */
+static void open_vf(const wc_self_state *s, const self_ctx *ctx, pair_slice *vf, int32_t p,
+                    int32_t q)
 {
     const csr *own = &s->patch_owned_particles, *tris = &s->patch_triangles;
     const double *pbox = s->patch_boxes + 6 * (size_t)p, *qbox = s->patch_boxes + 6 * (size_t)q;
+    double h = ctx->h, reach = REST_EXCLUSION * h;
     /* q's triangles that reach p at all (triangle boxes include h) */
     int32_t *near = slice_scratch(vf, tris->start[q + 1] - tris->start[q]);
     if (!near) return;
@@ -785,22 +867,35 @@ static void open_vf(const wc_self_state *s, pair_slice *vf, int32_t p, int32_t q
         int32_t v = own->items[a];
         const double *vbox = s->particle_boxes + 6 * (size_t)v;
         if (!boxes_overlap_by(vbox, qbox, h)) continue;
+        const double *vr = s->rest + 3 * (size_t)v;
+        double vrest[6] = {vr[0], vr[1], vr[2], vr[0], vr[1], vr[2]};
         for (int32_t b = 0; b < count; ++b) {
             int32_t t = near[b];
             const int32_t *tri = s->triangles + 3 * (size_t)t;
             const double *tbox = s->triangle_boxes + 6 * (size_t)t;
             if (tri[0] == v || tri[1] == v || tri[2] == v || !boxes_overlap_by(vbox, tbox, 0.0))
                 continue;
-            if (boxes_overlap_by(vbox, tbox, -h) || !rest_near_vf(s, v, tri, exclude2))
-                slice_push(vf, v, t);
+            /* The pair's own thickness only matters when the boxes meet
+             * within h but not closer; otherwise it is left to the first
+             * proximity test that needs it (-1). */
+            double hp = -1.0;
+            if (!boxes_overlap_by(vbox, tbox, -h)) {
+                hp = h;
+                if (boxes_overlap_by(vrest, s->rest_triangle_boxes + 6 * (size_t)t, reach)) {
+                    int32_t ids[4] = {v, tri[0], tri[1], tri[2]};
+                    hp = pair_thickness(ctx, rest2_vf(ctx, ids));
+                    if (!boxes_overlap_by(vbox, tbox, hp - h)) continue;
+                }
+            }
+            slice_push(vf, v, t);
+            slice_value(vf, hp);
         }
     }
 }
 
 /* Edges of patch p (owned) against edges of patch q (for p == q, each pair
- * once), with the same rule. */
-static void open_ee(const wc_self_state *s, pair_slice *ee, int32_t p, int32_t q, double h,
-                    double exclude2)
+ * once) whose boxes meet: edge pairs only need the continuous test. */
+static void open_ee(const wc_self_state *s, pair_slice *ee, int32_t p, int32_t q)
 {
     const csr *own = &s->patch_owned_edges;
     const double *pbox = s->patch_boxes + 6 * (size_t)p, *qbox = s->patch_boxes + 6 * (size_t)q;
@@ -808,7 +903,7 @@ static void open_ee(const wc_self_state *s, pair_slice *ee, int32_t p, int32_t q
     if (!near) return;
     int32_t count = 0;
     for (int32_t b = own->start[q]; b < own->start[q + 1]; ++b)
-        if (boxes_overlap_by(pbox, s->edge_boxes + 6 * (size_t)own->items[b], h))
+        if (boxes_overlap_by(pbox, s->edge_boxes + 6 * (size_t)own->items[b], 0.0))
             near[count++] = own->items[b];
     int32_t from = 0;
     for (int32_t a = own->start[p]; a < own->start[p + 1]; ++a) {
@@ -816,16 +911,13 @@ static void open_ee(const wc_self_state *s, pair_slice *ee, int32_t p, int32_t q
         /* p == q: near[] is p's edge list itself; pair each with later ones */
         if (p == q) from = a - own->start[p] + 1;
         const double *ebox = s->edge_boxes + 6 * (size_t)e;
-        if (!boxes_overlap_by(ebox, qbox, h)) continue;
+        if (!boxes_overlap_by(ebox, qbox, 0.0)) continue;
         const int32_t *ev = s->edges + 2 * (size_t)e;
         for (int32_t b = from; b < count; ++b) {
             int32_t f = near[b];
             const int32_t *fv = s->edges + 2 * (size_t)f;
             if (fv[0] == ev[0] || fv[0] == ev[1] || fv[1] == ev[0] || fv[1] == ev[1]) continue;
-            const double *fbox = s->edge_boxes + 6 * (size_t)f;
-            if (!boxes_overlap_by(ebox, fbox, h)) continue;
-            if (boxes_overlap_by(ebox, fbox, 0.0) || !rest_near_ee(s, ev, fv, exclude2))
-                slice_push(ee, e, f);
+            if (boxes_overlap_by(ebox, s->edge_boxes + 6 * (size_t)f, 0.0)) slice_push(ee, e, f);
         }
     }
 }
@@ -868,8 +960,10 @@ static int gather(const pair_slice *slices, int stride, int32_t **pairs, uint8_t
 static int32_t slice_begin(int64_t count, int k) { return (int32_t)(count * k / SLICES); }
 
 /* Boxes, cones, culling and candidate pairs of the current motion x -> nx. */
-static wc_status broadphase(wc_self_state *s, const wc_cloth *c, double h, double g, int threads)
+static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx *ctx, double g,
+                            int threads)
 {
+    double h = ctx->h;
     int32_t n = s->particle_count, nt = s->triangle_count, np = s->patch_count;
 #pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
     for (int32_t i = 0; i < n; ++i) particle_box(c, i, g, s->particle_boxes + 6 * (size_t)i);
@@ -948,22 +1042,30 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, double h, doubl
 
     /* Element pairs of the opened patch pairs: vertex-face both ways, then
      * edge-edge. */
-    double exclude2 = (REST_EXCLUSION * h) * (REST_EXCLUSION * h);
     for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (open >= 64)
     for (int k = 0; k < SLICES; ++k)
         for (int64_t m = slice_begin(open, k); m < slice_begin(open, k + 1); ++m) {
             int32_t p = s->open[2 * m], q = s->open[2 * m + 1];
-            open_vf(s, &s->slices[k], p, q, h, exclude2);
-            if (p != q) open_vf(s, &s->slices[k], q, p, h, exclude2);
+            open_vf(s, ctx, &s->slices[k], p, q);
+            if (p != q) open_vf(s, ctx, &s->slices[k], q, p);
         }
     if (!gather(s->slices, 2, &s->vf, &s->vf_status, &s->vf_count, &s->vf_capacity))
         return WC_ERROR_OUT_OF_MEMORY;
+    if (s->vf_h_capacity < s->vf_capacity) {
+        wc_free(s->vf_h);
+        s->vf_h = wc_alloc_array((size_t)s->vf_capacity, sizeof *s->vf_h);
+        s->vf_h_capacity = s->vf_h ? s->vf_capacity : 0;
+        if (!s->vf_h) return WC_ERROR_OUT_OF_MEMORY;
+    }
+    for (int k = 0, at = 0; k < SLICES; at += (int)s->slices[k].count, ++k)
+        if (s->slices[k].count)
+            memcpy(s->vf_h + at, s->slices[k].values, (size_t)s->slices[k].count * sizeof *s->vf_h);
     for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (open >= 64)
     for (int k = 0; k < SLICES; ++k)
         for (int64_t m = slice_begin(open, k); m < slice_begin(open, k + 1); ++m)
-            open_ee(s, &s->slices[k], s->open[2 * m], s->open[2 * m + 1], h, exclude2);
+            open_ee(s, &s->slices[k], s->open[2 * m], s->open[2 * m + 1]);
     if (!gather(s->slices, 2, &s->ee, &s->ee_status, &s->ee_count, &s->ee_capacity))
         return WC_ERROR_OUT_OF_MEMORY;
     return WC_OK;
@@ -973,26 +1075,17 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, double h, doubl
 /* Narrow phase                                                             */
 /* ------------------------------------------------------------------------ */
 
-typedef struct self_ctx {
-    const double *x, *y, *z, *nx, *ny, *nz;
-    const double *rest;
-    /// Thickness, CCD tolerance, squared rest distance below which pairs get
-    /// no proximity response.
-    double h, tol, exclude2;
-} self_ctx;
-
-enum { NO_CONTACT = 0, PROXIMITY = 1, COLLISION = 2 };
-
 /* A contact between two points of the cloth: the first is sum w_k X_k over
  * w_k > 0, the second over w_k < 0; their relative position D = sum w_k X_k.
  * n is unit (or zero when no direction could be found), with D at the start
- * of the step on its positive side; d0 = D(start) . n. */
+ * of the step on its positive side; d0 = D(start) . n; h is the pair's
+ * thickness. */
 typedef struct self_contact {
     int kind;
     int32_t p[4];
     double w[4];
     double n[3];
-    double d0;
+    double d0, h;
 } self_contact;
 
 static void relative(const double *x, const double *y, const double *z, const self_contact *k,
@@ -1037,10 +1130,12 @@ static void fallback_normal(const self_ctx *ctx, self_contact *k, double t)
     if (!normalize3(k->n)) k->n[0] = k->n[1] = k->n[2] = 0.0;
 }
 
+/* Largest |u_i - u_j| with i in the first group and j in the second: it
+ * bounds how fast the distance between the two elements changes over the
+ * step (points of an element move with convex combinations of its corners'
+ * motions). */
 static double max_relative_motion(double u[4][3], int first_count)
 {
-    /* Largest |u_i - u_j| with i among the first group and j in the second:
-     * it bounds how fast the distance between the two elements changes. */
     double l2 = 0.0;
     for (int i = 0; i < first_count; ++i)
         for (int j = first_count; j < 4; ++j) {
@@ -1051,55 +1146,71 @@ static double max_relative_motion(double u[4][3], int first_count)
     return sqrt(l2);
 }
 
-/* Vertex v against triangle tri. With ccd_only, proximity is not looked at. */
-static int eval_vf(const self_ctx *ctx, int32_t v, const int32_t *tri, int ccd_only,
-                   self_contact *k)
+/* Loads the four particles' start and end positions and motions; returns 0
+ * when the swept boxes of the two elements (the first `first` particles and
+ * the rest) are more than h apart. */
+static int load_pair(const self_ctx *ctx, const int32_t ids[4], int first, double margin,
+                     double p0[4][3], double p1[4][3], double u[4][3])
 {
-    double p0[4][3], p1[4][3], u[4][3];
-    int32_t ids[4] = {v, tri[0], tri[1], tri[2]};
     for (int j = 0; j < 4; ++j) {
         load(ctx->x, ctx->y, ctx->z, ids[j], p0[j]);
         load(ctx->nx, ctx->ny, ctx->nz, ids[j], p1[j]);
     }
-    /* Tight boxes of this motion: cheap rejection of most candidates. */
     for (int m = 0; m < 3; ++m) {
-        double plo = min2(p0[0][m], p1[0][m]) - ctx->h, phi = max2(p0[0][m], p1[0][m]) + ctx->h;
-        double tlo = p0[1][m], thi = p0[1][m];
-        for (int j = 1; j < 4; ++j) {
-            tlo = min2(tlo, min2(p0[j][m], p1[j][m]));
-            thi = max2(thi, max2(p0[j][m], p1[j][m]));
-        }
-        if (phi < tlo || plo > thi) return NO_CONTACT;
+        double alo = min2(p0[0][m], p1[0][m]), ahi = max2(p0[0][m], p1[0][m]);
+        for (int j = 1; j < first; ++j)
+            alo = min2(alo, min2(p0[j][m], p1[j][m])), ahi = max2(ahi, max2(p0[j][m], p1[j][m]));
+        double blo = min2(p0[first][m], p1[first][m]), bhi = max2(p0[first][m], p1[first][m]);
+        for (int j = first + 1; j < 4; ++j)
+            blo = min2(blo, min2(p0[j][m], p1[j][m])), bhi = max2(bhi, max2(p0[j][m], p1[j][m]));
+        if (ahi + margin < blo || alo - margin > bhi) return 0;
     }
     for (int j = 0; j < 4; ++j)
         for (int m = 0; m < 3; ++m) u[j][m] = p1[j][m] - p0[j][m];
-    double bary1[3], bary0[3];
+    return 1;
+}
+
+/* Vertex v against triangle tri; *hp is the pair's thickness, or -1 until
+ * first needed (then computed and kept: each pair is evaluated by one
+ * iteration at a time, and the value does not depend on when). With
+ * ccd_only, proximity is not looked at. */
+static int eval_vf(const self_ctx *ctx, int32_t v, const int32_t *tri, double *hp, int ccd_only,
+                   self_contact *k)
+{
+    double p0[4][3], p1[4][3], u[4][3];
+    int32_t ids[4] = {v, tri[0], tri[1], tri[2]};
+    if (!load_pair(ctx, ids, 1, ctx->h, p0, p1, u)) return NO_CONTACT;
+    for (int j = 0; j < 4; ++j) k->p[j] = ids[j];
+    double bary1[3];
     double d1 = sqrt(wc_point_triangle_closest(p1[0], p1[1], p1[2], p1[3], bary1));
-    double d0 = sqrt(wc_point_triangle_closest(p0[0], p0[1], p0[2], p0[3], bary0));
     /* The distance changes at most at rate L, so over the step it stays above
-     * (d0 + d1 - L) / 2: when that exceeds the tolerance the cubic cannot
-     * find a collision. */
+     * d1 - L, and above (d0 + d1 - L) / 2: when that exceeds the tolerance
+     * the cubic cannot find a collision. d0 only when d1 alone cannot tell. */
     double lip = max_relative_motion(u, 1);
-    k->p[0] = v, k->p[1] = tri[0], k->p[2] = tri[1], k->p[3] = tri[2];
-    if (0.5 * (d0 + d1 - lip) <= ctx->tol) {
-        double t, bary[3];
-        if (wc_ccd_point_triangle(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3],
-                                  ctx->tol, &t, bary)) {
-            k->kind = COLLISION;
-            k->w[0] = 1.0, k->w[1] = -bary[0], k->w[2] = -bary[1], k->w[3] = -bary[2];
-            double a[3], b[3], c[3];
-            lerp3(p0[1], p1[1], t, a), lerp3(p0[2], p1[2], t, b), lerp3(p0[3], p1[3], t, c);
-            wc_triangle_normal(a, b, c, k->n);
-            if (dot3(k->n, k->n) == 0.0) fallback_normal(ctx, k, t);
-            orient(ctx, k);
-            return COLLISION;
-        }
+    int ccd = d1 - lip <= ctx->tol;
+    if (ccd) {
+        double bary0[3];
+        double d0 = sqrt(wc_point_triangle_closest(p0[0], p0[1], p0[2], p0[3], bary0));
+        ccd = 0.5 * (d0 + d1 - lip) <= ctx->tol;
+    }
+    double t, bary[3];
+    if (ccd && wc_ccd_point_triangle(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3],
+                                     ctx->tol, &t, bary)) {
+        k->kind = COLLISION;
+        if (*hp < 0.0) *hp = pair_thickness(ctx, rest2_vf(ctx, ids));
+        k->h = *hp;
+        k->w[0] = 1.0, k->w[1] = -bary[0], k->w[2] = -bary[1], k->w[3] = -bary[2];
+        double a[3], b[3], c[3];
+        lerp3(p0[1], p1[1], t, a), lerp3(p0[2], p1[2], t, b), lerp3(p0[3], p1[3], t, c);
+        wc_triangle_normal(a, b, c, k->n);
+        if (dot3(k->n, k->n) == 0.0) fallback_normal(ctx, k, t);
+        orient(ctx, k);
+        return COLLISION;
     }
     if (ccd_only || !(d1 < ctx->h)) return NO_CONTACT;
-    double r[4][3];
-    for (int j = 0; j < 4; ++j) memcpy(r[j], ctx->rest + 3 * (size_t)ids[j], sizeof r[j]);
-    double bary_rest[3];
-    if (wc_point_triangle_closest(r[0], r[1], r[2], r[3], bary_rest) < ctx->exclude2) return NO_CONTACT;
+    if (*hp < 0.0) *hp = pair_thickness(ctx, rest2_vf(ctx, ids));
+    if (!(d1 < *hp)) return NO_CONTACT;
+    k->h = *hp;
     k->kind = PROXIMITY;
     k->w[0] = 1.0, k->w[1] = -bary1[0], k->w[2] = -bary1[1], k->w[3] = -bary1[2];
     for (int m = 0; m < 3; ++m)
@@ -1113,68 +1224,49 @@ static int eval_vf(const self_ctx *ctx, int32_t v, const int32_t *tri, int ccd_o
     return PROXIMITY;
 }
 
-/* Edge (a, b) against edge (c, d). */
+/* Edge (a, b) against edge (c, d): the continuous test only. */
 static int eval_ee(const self_ctx *ctx, const int32_t *e, const int32_t *f, int ccd_only,
                    self_contact *k)
 {
     double p0[4][3], p1[4][3], u[4][3];
     int32_t ids[4] = {e[0], e[1], f[0], f[1]};
-    for (int j = 0; j < 4; ++j) {
-        load(ctx->x, ctx->y, ctx->z, ids[j], p0[j]);
-        load(ctx->nx, ctx->ny, ctx->nz, ids[j], p1[j]);
-    }
-    for (int m = 0; m < 3; ++m) {
-        double alo = min2(min2(p0[0][m], p1[0][m]), min2(p0[1][m], p1[1][m])) - ctx->h;
-        double ahi = max2(max2(p0[0][m], p1[0][m]), max2(p0[1][m], p1[1][m])) + ctx->h;
-        double blo = min2(min2(p0[2][m], p1[2][m]), min2(p0[3][m], p1[3][m]));
-        double bhi = max2(max2(p0[2][m], p1[2][m]), max2(p0[3][m], p1[3][m]));
-        if (ahi < blo || alo > bhi) return NO_CONTACT;
-    }
-    for (int j = 0; j < 4; ++j)
-        for (int m = 0; m < 3; ++m) u[j][m] = p1[j][m] - p0[j][m];
-    double s1, t1, s0, t0;
-    double d1 = sqrt(wc_segment_segment_closest(p1[0], p1[1], p1[2], p1[3], &s1, &t1));
-    double d0 = sqrt(wc_segment_segment_closest(p0[0], p0[1], p0[2], p0[3], &s0, &t0));
-    double lip = max_relative_motion(u, 2);
+    if (!load_pair(ctx, ids, 2, ctx->tol, p0, p1, u)) return NO_CONTACT;
     for (int j = 0; j < 4; ++j) k->p[j] = ids[j];
-    if (0.5 * (d0 + d1 - lip) <= ctx->tol) {
-        double t, s, v;
-        if (wc_ccd_edge_edge(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3], ctx->tol,
-                             &t, &s, &v)) {
-            k->kind = COLLISION;
-            k->w[0] = 1.0 - s, k->w[1] = s, k->w[2] = -(1.0 - v), k->w[3] = -v;
-            double a[3], b[3], c[3], d[3], ea[3], eb[3];
-            lerp3(p0[0], p1[0], t, a), lerp3(p0[1], p1[1], t, b);
-            lerp3(p0[2], p1[2], t, c), lerp3(p0[3], p1[3], t, d);
-            for (int m = 0; m < 3; ++m) ea[m] = b[m] - a[m], eb[m] = d[m] - c[m];
-            k->n[0] = ea[1] * eb[2] - ea[2] * eb[1];
-            k->n[1] = ea[2] * eb[0] - ea[0] * eb[2];
-            k->n[2] = ea[0] * eb[1] - ea[1] * eb[0];
-            /* Nearly parallel edges have no reliable cross product. */
-            if (dot3(k->n, k->n) <= 1e-12 * dot3(ea, ea) * dot3(eb, eb) || !normalize3(k->n))
-                fallback_normal(ctx, k, t);
-            orient(ctx, k);
-            return COLLISION;
-        }
+    double s1, t1;
+    double d1 = sqrt(wc_segment_segment_closest(p1[0], p1[1], p1[2], p1[3], &s1, &t1));
+    double lip = max_relative_motion(u, 2);
+    int ccd = d1 - lip <= ctx->tol;
+    if (ccd) {
+        double s0, t0;
+        double d0 = sqrt(wc_segment_segment_closest(p0[0], p0[1], p0[2], p0[3], &s0, &t0));
+        ccd = 0.5 * (d0 + d1 - lip) <= ctx->tol;
     }
-    if (ccd_only || !(d1 < ctx->h)) return NO_CONTACT;
-    double r[4][3], rs, rt;
-    for (int j = 0; j < 4; ++j) memcpy(r[j], ctx->rest + 3 * (size_t)ids[j], sizeof r[j]);
-    if (wc_segment_segment_closest(r[0], r[1], r[2], r[3], &rs, &rt) < ctx->exclude2) return NO_CONTACT;
-    k->kind = PROXIMITY;
-    k->w[0] = 1.0 - s1, k->w[1] = s1, k->w[2] = -(1.0 - t1), k->w[3] = -t1;
-    for (int m = 0; m < 3; ++m)
-        k->n[m] = (1.0 - s1) * p1[0][m] + s1 * p1[1][m] - (1.0 - t1) * p1[2][m] - t1 * p1[3][m];
-    if (!(d1 > 1e-9 * ctx->h) || !normalize3(k->n)) fallback_normal(ctx, k, 1.0);
-    orient(ctx, k);
-    return PROXIMITY;
+    double t, s, v;
+    if (ccd && wc_ccd_edge_edge(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3], ctx->tol,
+                                &t, &s, &v)) {
+        k->kind = COLLISION;
+        k->h = pair_thickness(ctx, rest2_ee(ctx, ids));
+        k->w[0] = 1.0 - s, k->w[1] = s, k->w[2] = -(1.0 - v), k->w[3] = -v;
+        double a[3], b[3], c[3], d[3], ea[3], eb[3];
+        lerp3(p0[0], p1[0], t, a), lerp3(p0[1], p1[1], t, b);
+        lerp3(p0[2], p1[2], t, c), lerp3(p0[3], p1[3], t, d);
+        for (int m = 0; m < 3; ++m) ea[m] = b[m] - a[m], eb[m] = d[m] - c[m];
+        cross3(ea, eb, k->n);
+        /* Nearly parallel edges have no reliable cross product. */
+        if (dot3(k->n, k->n) <= 1e-12 * dot3(ea, ea) * dot3(eb, eb) || !normalize3(k->n))
+            fallback_normal(ctx, k, t);
+        orient(ctx, k);
+        return COLLISION;
+    }
+    (void)ccd_only; /* edge pairs have no proximity: see the header */
+    return NO_CONTACT;
 }
 
-static int vf_pair(const wc_self_state *s, const self_ctx *ctx, int64_t i, int ccd_only,
+static int vf_pair(wc_self_state *s, const self_ctx *ctx, int64_t i, int ccd_only,
                    self_contact *k)
 {
     const int32_t *pr = s->vf + 2 * i;
-    return eval_vf(ctx, pr[0], s->triangles + 3 * (size_t)pr[1], ccd_only, k);
+    return eval_vf(ctx, pr[0], s->triangles + 3 * (size_t)pr[1], s->vf_h + i, ccd_only, k);
 }
 
 static int ee_pair(const wc_self_state *s, const self_ctx *ctx, int64_t i, int ccd_only,
@@ -1215,7 +1307,7 @@ static void evaluate(wc_self_state *s, const self_ctx *ctx, int ccd_only, int th
 /* Answers one contact against the current state: moves nx (and q for the
  * part that must not become velocity), marks contacts. Returns whether any
  * particle moved. */
-static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double h, double mu,
+static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double mu, double slack,
                    int32_t *marked)
 {
     double im[4], weight = 0.0;
@@ -1254,13 +1346,21 @@ static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double 
      * min(start separation, h), so a pair never ends closer than it started
      * unless it stays h apart; a proximity's target is h. dp < 0 means the
      * pair entered the band this step and settles onto it. */
-    double target = k->kind == COLLISION ? fmin(k->d0, h) : h;
+    double h = k->h, target = h;
+    if (k->kind == COLLISION) {
+        /* never closer than at the start (unless h apart), but at least a
+         * tenth of h: elements that start touching are parted a little, or
+         * the continuous test would find them again */
+        target = k->d0 > h ? h : k->d0 < 0.1 * h ? 0.1 * h : k->d0;
+    }
     double dv = un < 0.0 ? -un : 0.0;
     double dp = target - (sep + dv);
     /* A collision whose normal motion already keeps the target cannot be
-     * answered along n (the elements touched at the start): the fail-safe
-     * takes it. */
+     * answered along n: the fail-safe takes it. */
     if (k->kind == COLLISION && !(sep < target)) return 0;
+    /* After the first pass, leftovers below the slack are not worth another
+     * pass (proximity only: a collision is always answered). */
+    if (k->kind == PROXIMITY && dv <= slack && fabs(dp) <= slack) return 0;
     if (dv == 0.0 && dp <= 0.0) return 0;
     /* Coulomb friction on the relative tangential motion: its change is at
      * most mu times the normal change (tangential part of du is unchanged by
@@ -1302,21 +1402,22 @@ static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double 
 /* Serial pass over the flagged pairs in candidate order: each is evaluated
  * again against the current state (earlier responses of the pass may have
  * answered it already) and answered. Returns whether anything moved. */
-static int respond_all(wc_cloth *c, wc_self_state *s, const self_ctx *ctx, int32_t *marked)
+static int respond_all(wc_cloth *c, wc_self_state *s, const self_ctx *ctx, int pass,
+                       int32_t *marked)
 {
-    double h = ctx->h, mu = c->material.friction;
+    double mu = c->material.friction, slack = pass ? RESIDUAL * ctx->h : 0.0;
     int moved = 0;
     for (int64_t i = 0; i < s->vf_count; ++i) {
         if (!s->vf_status[i]) continue;
         self_contact k;
         s->vf_status[i] = (uint8_t)vf_pair(s, ctx, i, 0, &k);
-        if (s->vf_status[i]) moved |= respond(c, s, &k, h, mu, marked);
+        if (s->vf_status[i]) moved |= respond(c, s, &k, mu, slack, marked);
     }
     for (int64_t i = 0; i < s->ee_count; ++i) {
         if (!s->ee_status[i]) continue;
         self_contact k;
         s->ee_status[i] = (uint8_t)ee_pair(s, ctx, i, 0, &k);
-        if (s->ee_status[i]) moved |= respond(c, s, &k, h, mu, marked);
+        if (s->ee_status[i]) moved |= respond(c, s, &k, mu, slack, marked);
     }
     return moved;
 }
@@ -1409,7 +1510,9 @@ static wc_status failsafe(wc_cloth *c, wc_self_state *s, self_ctx *ctx, double g
         if (!newly) break;
         total += newly;
         if (!still_valid(s, c)) {
-            if (broadphase(s, c, ctx->h, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+            s->built = 0;
+            if (broadphase(s, c, ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+            s->built = 1;
             memset(s->dirty, 1, (size_t)s->particle_count);
         }
         evaluate(s, ctx, 1, threads);
@@ -1417,24 +1520,6 @@ static wc_status failsafe(wc_cloth *c, wc_self_state *s, self_ctx *ctx, double g
     *count = total;
     return WC_OK;
 }
-
-#ifdef WC_SELF_PROFILE
-#include <stdio.h>
-#include <omp.h>
-static long prof_calls, prof_open, prof_vf, prof_ee, prof_passes, prof_rebuilds, prof_np, prof_culled, prof_reverted;
-static double prof_t_total, prof_t_broad, prof_t_eval, prof_t_respond, prof_t_fail;
-static void prof_report(void)
-{
-    if (prof_calls)
-        fprintf(stderr, "self time: total %.3f s, broadphase %.3f, evaluate %.3f, respond %.3f, failsafe %.3f; reverted %ld\n",
-                prof_t_total, prof_t_broad, prof_t_eval, prof_t_respond, prof_t_fail, prof_reverted);
-    if (prof_calls)
-        fprintf(stderr, "self: %ld calls; per call: patches %.0f culled %.0f open %.1f vf %.1f ee %.1f passes %.2f rebuilds %.3f\n",
-                prof_calls, (double)prof_np / prof_calls, (double)prof_culled / prof_calls, (double)prof_open / prof_calls,
-                (double)prof_vf / prof_calls, (double)prof_ee / prof_calls, (double)prof_passes / prof_calls,
-                (double)prof_rebuilds / prof_calls);
-}
-#endif
 
 wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *stats)
 {
@@ -1451,43 +1536,32 @@ wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *st
     ctx.x = c->x, ctx.y = c->y, ctx.z = c->z, ctx.nx = c->nx, ctx.ny = c->ny, ctx.nz = c->nz;
     double g = BOX_MARGIN * ctx.h;
     int32_t marked = 0, reverted = 0;
-    int rebuild = 1;
-#ifdef WC_SELF_PROFILE
-    double t_start = omp_get_wtime(), t0;
-#define PROF_T(acc, stmt) (t0 = omp_get_wtime(), stmt, acc += omp_get_wtime() - t0)
-#else
-#define PROF_T(acc, stmt) (stmt)
-#endif
+    /* Candidates from an earlier step hold as long as every particle's
+     * motion stays inside its box and the culled patches keep their cones
+     * (still_valid with every particle marked): cloth at rest or moving
+     * slowly skips the broadphase. */
+    int rebuild = !(s->built && s->built_h == ctx.h);
+    if (!rebuild) {
+        memset(s->dirty, 1, (size_t)s->particle_count);
+        rebuild = !still_valid(s, c);
+        if (!rebuild) {
+            if (s->vf_count) memset(s->vf_status, 0, (size_t)s->vf_count);
+            if (s->ee_count) memset(s->ee_status, 0, (size_t)s->ee_count);
+        }
+    }
     for (int pass = 0;; ++pass) {
         if (rebuild) {
-            wc_status bs;
-            PROF_T(prof_t_broad, bs = broadphase(s, c, ctx.h, g, threads));
-            if (bs) return WC_ERROR_OUT_OF_MEMORY;
+            s->built = 0;
+            if (broadphase(s, c, &ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+            s->built = 1, s->built_h = ctx.h;
             memset(s->dirty, 1, (size_t)s->particle_count);
         }
         int last = pass >= SELF_PASSES;
-#ifdef WC_SELF_PROFILE
-        if (!prof_calls++) atexit(prof_report);
-        prof_passes++;
-        if (rebuild) {
-            prof_rebuilds++, prof_open += s->open_count, prof_vf += s->vf_count, prof_ee += s->ee_count, prof_np += s->patch_count;
-            for (int32_t p = 0; p < s->patch_count; ++p) prof_culled += s->patch_culled[p];
-        }
-        if (pass) prof_calls--;
-#endif
-        PROF_T(prof_t_eval, evaluate(s, &ctx, last, threads));
-        int moved = 0;
-        if (!last) PROF_T(prof_t_respond, moved = respond_all(c, s, &ctx, &marked));
-        if (last || !moved) break;
-        PROF_T(prof_t_respond, rebuild = !still_valid(s, c));
+        evaluate(s, &ctx, last, threads);
+        if (last || !respond_all(c, s, &ctx, pass, &marked)) break;
+        rebuild = !still_valid(s, c);
     }
-    wc_status fs;
-    PROF_T(prof_t_fail, fs = failsafe(c, s, &ctx, g, threads, &reverted));
-    if (fs) return WC_ERROR_OUT_OF_MEMORY;
-#ifdef WC_SELF_PROFILE
-    prof_t_total += omp_get_wtime() - t_start;
-    prof_reverted += reverted;
-#endif
+    if (failsafe(c, s, &ctx, g, threads, &reverted)) return WC_ERROR_OUT_OF_MEMORY;
     if (stats) {
         stats->cloth_contacts += marked;
         stats->failsafe_particles += reverted;
