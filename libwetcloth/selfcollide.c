@@ -2,7 +2,15 @@
  * & Anderson 2002, "Robust treatment of collisions, contact and friction for
  * cloth animation", with the normal-cone culling of Volino & Magnenat-
  * Thalmann 1994 ("Efficient self-collision detection on smoothly
- * discretized surface animations") in the broadphase:
+ * discretized surface animations") in the broadphase.
+ *
+ * What is tested: vertex-face pairs (vertex not a corner of the face) for
+ * proximity at the end of the step and for collision during it (the
+ * coplanarity cubic); edge-edge pairs (no shared vertex) for collision
+ * during the step. Edges get no proximity repulsion: SPEC asks particles to
+ * keep the thickness, which vertex-face proximity does, and edge pairs within
+ * h of each other are several times more numerous than vertex-face ones in
+ * stacked layers; crossing edges are still stopped by the continuous test.
  *
  *  1. Broadphase. The triangles are grouped once, in the rest shape, into
  *     small connected patches (about 4 x 4 quads). Every particle gets a box
@@ -10,26 +18,29 @@
  *     of their particles' boxes and a cone that holds every triangle normal
  *     of the patch over the whole step. A connected piece of surface whose
  *     normals all stay within 90 degrees of one direction is a height field
- *     over the plane across it and cannot pass through itself; within 60
- *     degrees it cannot even bring two points closer than half their
- *     distance along the surface (see REST_EXCLUSION). So a patch with a
- *     narrow cone, and two neighbouring patches (sharing a vertex) whose
+ *     over the plane across it and cannot pass through itself (the contour
+ *     condition of Volino & Magnenat-Thalmann is not checked: a compact
+ *     patch cannot wind around itself without tearing); within 60 degrees
+ *     it cannot even bring two points closer than half their distance along
+ *     the surface (see REST_EXCLUSION). So a patch with a narrow cone, and
+ *     two patches sharing a vertex, or both sharing one with a third, whose
  *     joint cone is narrow, need no element tests at all. Only the other
  *     pairs of patches whose boxes come within the thickness h (a uniform
- *     grid finds them) are opened up into vertex-face pairs (vertex not a
- *     corner of the face) and edge-edge pairs (no shared vertex) with
- *     overlapping boxes. A falling or draped cloth costs a pass over its
- *     particles and triangles; folds cost what they touch.
- *     The candidates stay valid while every particle stays inside its box
- *     and the culled patches keep their narrow cones; a response that breaks
- *     either triggers a rebuild.
+ *     grid finds them) are opened up into element pairs with overlapping
+ *     boxes. A falling or draped cloth costs a pass over its particles and
+ *     triangles; folds cost what they touch.
+ *     The candidates stay valid while every particle's motion stays inside
+ *     its box and the culled patches keep their narrow cones: a response that
+ *     breaks either triggers a rebuild, and the next step reuses them when
+ *     neither broke (cloth at rest or moving slowly skips the broadphase).
  *  2. Passes. Each pass evaluates (in parallel, one status byte per pair)
- *     the pairs with a particle that moved since their last evaluation: a
- *     continuous test of the step's motion (the coplanarity cubic) and, when
- *     that finds nothing, the distance at the end of the step. Then, serially
- *     and in candidate order (so the result does not depend on the thread
- *     count), each flagged pair is evaluated again against the current state
- *     and answered with an inelastic impulse and Coulomb friction; impulses
+ *     the pairs with a particle that moved since their last evaluation: the
+ *     continuous test and, when that finds nothing, the distance at the end
+ *     of the step. Then, serially and in candidate order (so the result does
+ *     not depend on the thread count), each flagged pair is evaluated again
+ *     against the current state and answered: an inelastic impulse that
+ *     removes the approach along the contact normal, a position correction
+ *     (not velocity) to the pair's thickness, and Coulomb friction; impulses
  *     are split by inverse mass with the barycentric weights (Bridson et al.
  *     eq. 4).
  *  3. Fail-safe. Pairs whose motion still collides after the passes put
@@ -47,7 +58,9 @@
  * The side a vertex is on comes from the start of the step: every contact
  * normal is oriented so that the relative position of the two contact
  * points at the start of the step lies on its positive side, and responses
- * only push along it, so nothing is pushed across. */
+ * only push along it, so nothing is pushed across. A particle resting on a
+ * collider (marked earlier in the step) is not pushed into it: along that
+ * surface's normal it counts as pinned. */
 #include "selfcollide.h"
 
 #include <math.h>
@@ -71,12 +84,12 @@
 #define BOX_MARGIN 0.25
 /* Pairs closer than this many thicknesses in the rest shape are neighbours
  * in the cloth itself (for instance across a quad's diagonal): the cloth's
- * own links keep them apart, so they get no proximity repulsion, which would
- * fight those links. They still get the continuous test. With 2, and culled
+ * own links keep them apart, so they keep only half their rest distance
+ * (pair_thickness), not h, which would fight those links. With 2, and culled
  * patches whose normals stay within 60 degrees of a common direction (so
  * distances in space are at least cos 60 = 1/2 of those along the surface),
- * no culled pair that is not such a neighbour can be within h unless the
- * cloth is compressed. */
+ * no culled pair can come within its thickness unless the cloth is
+ * compressed. */
 #define REST_EXCLUSION 2.0
 /* Largest angle between a culled region's normals and its cone axis. */
 #define CONE_COS 0.5
@@ -121,8 +134,6 @@ struct wc_self_state {
     const int32_t *triangles;
     /// Unique edges of the triangles, 2 particles each (lower index first).
     int32_t *edges;
-    /// The 3 edge ids of each triangle (edge k joins corners k and k+1).
-    int32_t *triangle_edges;
     /// Lowest-index triangle holding each edge.
     int32_t *edge_owner;
     /// Rest shape (positions at creation), xyz per particle, and the boxes of
@@ -314,19 +325,15 @@ static int compare_edge_entries(const void *pa, const void *pb)
     return p->slot < q->slot ? -1 : (p->slot > q->slot);
 }
 
-/* The unique edges of the triangles, each triangle's edge ids, each edge's
- * owner triangle, and (for growing patches) each triangle's neighbours
+/* The unique edges of the triangles, each edge's owner triangle, the mean
+ * rest edge length, and (for growing patches) each triangle's neighbours
  * across edges shared by exactly two triangles. */
 static int build_edges(wc_self_state *s, const wc_cloth *c, int32_t *neighbours)
 {
     int32_t t_count = s->triangle_count;
     size_t entries = 3 * (size_t)t_count;
     edge_entry *e = wc_alloc_array(entries, sizeof *e);
-    s->triangle_edges = wc_alloc_array(entries, sizeof *s->triangle_edges);
-    if (!e || !s->triangle_edges) {
-        wc_free(e);
-        return 0;
-    }
+    if (!e) return 0;
     for (int32_t t = 0; t < t_count; ++t)
         for (int k = 0; k < 3; ++k) {
             int32_t a = s->triangles[3 * (size_t)t + k], b = s->triangles[3 * (size_t)t + (k + 1) % 3];
@@ -366,7 +373,6 @@ static int build_edges(wc_self_state *s, const wc_cloth *c, int32_t *neighbours)
                 neighbours[3 * (size_t)e[k + 1].triangle + e[k + 1].slot] = e[k].triangle;
             }
         }
-        s->triangle_edges[3 * (size_t)e[k].triangle + e[k].slot] = id;
     }
     s->mean_edge = unique ? total / unique : 0.0;
     wc_free(e);
@@ -419,10 +425,8 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
         qsort(bins, (size_t)nt, sizeof *bins, compare_bins);
         int32_t b = -1;
         for (int32_t k = 0; k < nt; ++k) {
-            if (k == 0 || compare_bins(&bins[k], &bins[k - 1]) != 0) {
-                const int64_t *p = bins[k].key, *q = k ? bins[k - 1].key : NULL;
-                if (!q || p[0] != q[0] || p[1] != q[1] || p[2] != q[2]) ++b;
-            }
+            const int64_t *p = bins[k].key, *q = k ? bins[k - 1].key : NULL;
+            if (!q || p[0] != q[0] || p[1] != q[1] || p[2] != q[2]) ++b;
             bin_of[bins[k].triangle] = b;
         }
         int32_t patches = 0;
@@ -443,8 +447,8 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
                     queue[tail++] = u;
                 }
             }
-            /* Queued beyond the limit (none, by the check above) would be
-             * released here; the patch is exactly queue[0 .. tail). */
+            /* Nothing is queued beyond PATCH_MAX (checked when queueing), so
+             * the patch is exactly queue[0 .. tail). */
             ++patches;
         }
         s->patch_count = patches;
@@ -584,7 +588,7 @@ wc_self_state *wc_self_state_create(const wc_cloth *c)
 void wc_self_state_destroy(wc_self_state *s)
 {
     if (!s) return;
-    void *blocks[] = {s->edges, s->triangle_edges, s->edge_owner, s->rest, s->rest_triangle_boxes,
+    void *blocks[] = {s->edges, s->edge_owner, s->rest, s->rest_triangle_boxes,
                       s->rest_edge_boxes, s->triangle_patch,
                       s->particle_boxes, s->triangle_boxes, s->edge_boxes, s->triangle_normals,
                       s->patch_boxes, s->patch_grown, s->patch_axis, s->patch_cos,
