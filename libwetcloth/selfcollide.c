@@ -1346,10 +1346,11 @@ static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double 
     /* Inelastic: the approach along n is removed (dv, a change of velocity),
      * then the end separation is set to the target (dp, a change of position
      * only): the pair ends the step at the target, at rest relative to each
-     * other along n. For a collision during the step the target is
-     * min(start separation, h), so a pair never ends closer than it started
-     * unless it stays h apart; a proximity's target is h. dp < 0 means the
-     * pair entered the band this step and settles onto it. */
+     * other along n. h is the pair's thickness (pair_thickness). For a
+     * collision during the step the target is min(start separation, h), so
+     * a pair never ends closer than it started unless it stays h apart; a
+     * proximity's target is h. dp < 0 means the pair entered the band this
+     * step and settles onto it. */
     double h = k->h, target = h;
     if (k->kind == COLLISION) {
         /* never closer than at the start (unless h apart), but at least a
