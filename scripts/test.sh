@@ -2,13 +2,20 @@
 # Runs all the tests:
 #   build/       Release, -DWC_WERROR=ON
 #   build-asan/  Debug, AddressSanitizer + UndefinedBehaviorSanitizer, -DWC_WERROR=ON
-# and `ctest --output-on-failure` in each. Exits non-zero if either fails.
+# and `ctest --output-on-failure` in each: the C tests, and the Python tests
+# (binding, scene runner, command line, `pip install .`) with the
+# interpreter of .venv/ (made by scripts/venv.sh). Exits non-zero if either
+# fails.
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 
 scripts/install-deps.sh
+scripts/venv.sh
+
+# The Python tests must run here: a missing package is an error, not a skip.
+python_args=(-DWC_PYTHON="$root/.venv/bin/python" -DWC_PYTHON_REQUIRED=ON)
 
 jobs=$(nproc 2>/dev/null || echo 2)
 
@@ -40,8 +47,8 @@ run_build() {
 
 release_type=()
 [ -f build/CMakeCache.txt ] || release_type=(-DCMAKE_BUILD_TYPE=Release)
-run_build normal build "${release_type[@]}" -DWC_WERROR=ON
-run_build sanitizer build-asan -DWC_SANITIZE=ON -DWC_WERROR=ON -DCMAKE_BUILD_TYPE=Debug
+run_build normal build "${release_type[@]}" -DWC_WERROR=ON "${python_args[@]}"
+run_build sanitizer build-asan -DWC_SANITIZE=ON -DWC_WERROR=ON -DCMAKE_BUILD_TYPE=Debug "${python_args[@]}"
 
 echo
 echo "==== summary"

@@ -1,0 +1,56 @@
+"""Finds and loads the compiled libwetcloth (cffi ABI mode: no compiler).
+
+The library is looked for, in this order:
+
+1. the file named by the environment variable WETCLOTH_LIBRARY, if set
+   (it must exist: a wrong path is an error, not a fallback);
+2. ``libwetcloth.so`` in each folder of the package's ``__path__``: where
+   ``pip install .`` puts it, also for editable installs, whose ``__path__``
+   spans the source tree and the installed files.
+"""
+
+import os
+
+from ._ffi import ffi
+
+ENV_VAR = "WETCLOTH_LIBRARY"
+LIBRARY_NAMES = ("libwetcloth.so", "libwetcloth.dylib", "wetcloth.dll")
+
+
+def find_library(package_path):
+    """Path of the shared library to load (see the module docstring)."""
+    override = os.environ.get(ENV_VAR)
+    if override:
+        if not os.path.isfile(override):
+            raise ImportError(
+                "%s is set to %r, which is not a file; point it at libwetcloth.so "
+                "or unset it to use the library inside the package" % (ENV_VAR, override))
+        return override
+    searched = []
+    for folder in package_path:
+        for name in LIBRARY_NAMES:
+            candidate = os.path.join(folder, name)
+            if os.path.isfile(candidate):
+                return candidate
+        searched.append(folder)
+    raise ImportError(
+        "libwetcloth's shared library is not in the wetcloth package (looked in %s). "
+        "Install the package with 'pip install .' at the repository root, or set %s "
+        "to the path of a built libwetcloth.so" % (", ".join(searched) or "nothing", ENV_VAR))
+
+
+def load(package_path):
+    """(lib, path): the loaded library and where it came from."""
+    path = find_library(package_path)
+    try:
+        lib = ffi.dlopen(os.path.abspath(path))
+    except OSError as e:
+        raise ImportError("cannot load libwetcloth from %s: %s" % (path, e)) from None
+    major, minor = lib.WC_VERSION_MAJOR, lib.WC_VERSION_MINOR
+    found = lib.wc_version()
+    if found // 100 != major * 100 + minor:
+        raise ImportError(
+            "%s is libwetcloth %s, but this binding was generated from the %d.%d header; "
+            "0.x versions must match in major and minor" %
+            (path, ffi.string(lib.wc_version_string()).decode(), major, minor))
+    return lib, path
