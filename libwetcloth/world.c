@@ -152,6 +152,10 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
                                "its last good state", (int)c);
             if (!moved) break;
         }
+        /* before self-collision, which must see held particles as resting
+         * on their collider */
+        if (cl->wet_forces && w->collider_count)
+            wc_wet_hold_contacts(cl, w->colliders, w->collider_count, threads);
         if (cl->self && wc_self_collide(cl, dt, threads, &w->stats))
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory in the self-collision of cloth %d; the world keeps its "

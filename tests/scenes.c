@@ -115,23 +115,35 @@ uint64_t scene_hash_positions(const wc_world *w, int32_t cloth)
     return h;
 }
 
-int scene_count_near_sphere(const wc_world *w, int32_t cloth, double radius, double within)
+void scene_distances_to_mesh(const double *points, int32_t count, const double *vertices,
+                             const int32_t *triangles, int32_t triangle_count, double *out)
 {
-    double v[3 * 114], bary[3];
-    int32_t t[3 * 224], nt, near = 0, n = wc_cloth_particle_count(w, cloth);
-    double *p = malloc(3 * sizeof(double) * (size_t)n);
-    if (!p) return -1;
-    scene_uv_sphere(radius, 16, 8, v, t, &nt);
-    wc_cloth_get_positions(w, cloth, p, n);
-    for (int32_t i = 0; i < n; ++i) {
+    double bary[3];
+    for (int32_t i = 0; i < count; ++i) {
         double best = INFINITY;
-        for (int32_t k = 0; k < nt; ++k) {
-            double d = wc_point_triangle_closest(p + 3 * i, v + 3 * t[3 * k], v + 3 * t[3 * k + 1],
-                                                 v + 3 * t[3 * k + 2], bary);
+        for (int32_t k = 0; k < triangle_count; ++k) {
+            const int32_t *c = triangles + 3 * (size_t)k;
+            double d = wc_point_triangle_closest(points + 3 * (size_t)i, vertices + 3 * c[0],
+                                                 vertices + 3 * c[1], vertices + 3 * c[2], bary);
             if (d < best) best = d;
         }
-        near += sqrt(best) < within;
+        out[i] = sqrt(best);
     }
-    free(p);
+}
+
+int scene_count_near_sphere(const wc_world *w, int32_t cloth, double radius, double within)
+{
+    double v[3 * 114];
+    int32_t t[3 * 224], nt, near = 0, n = wc_cloth_particle_count(w, cloth);
+    double *p = malloc(3 * sizeof(double) * (size_t)n), *d = malloc(sizeof(double) * (size_t)n);
+    if (!p || !d) {
+        free(p), free(d);
+        return -1;
+    }
+    scene_uv_sphere(radius, 16, 8, v, t, &nt);
+    wc_cloth_get_positions(w, cloth, p, n);
+    scene_distances_to_mesh(p, n, v, t, nt, d);
+    for (int32_t i = 0; i < n; ++i) near += d[i] < within;
+    free(p), free(d);
     return near;
 }

@@ -35,6 +35,11 @@ void scene_plate_vertices(const double center[3], const double u[3], const doubl
 /// triangles: independent of the solver's broadphase.
 int scene_count_near_sphere(const wc_world *world, int32_t cloth, double radius, double within);
 
+/// Distance of each of `count` points (xyz) to a triangle mesh, by brute
+/// force over its triangles: independent of the solver's broadphase.
+void scene_distances_to_mesh(const double *points, int32_t count, const double *vertices,
+                             const int32_t *triangles, int32_t triangle_count, double *out);
+
 /// FNV-1a hash of a cloth's positions (bitwise).
 uint64_t scene_hash_positions(const wc_world *world, int32_t cloth);
 
