@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian/Ubuntu packages libwetcloth needs to build and test,
+# Installs the Debian/Ubuntu packages libwetcloth needs to build and test
+# (the Python packages come from PyPI into .venv/: scripts/venv.sh),
 # only those that are missing. Runs apt-get only when something is missing;
 # uses sudo when not root (and sudo exists). Called by setup.sh and test.sh.
 set -euo pipefail
