@@ -98,6 +98,7 @@ static wc_status mesh_begin_step(wc_collider *c, double share)
     if (!s) s = wc_grid_build(&c->vertex_grid, c->vertex_boxes, c->vertex_count, cell);
     if (!s) s = wc_grid_build(&c->edge_grid, c->edge_boxes, c->edge_count, cell);
     c->grid_static = !c->moving && s == WC_OK;
+    c->grid_version++;
     return s;
 }
 

@@ -6,6 +6,7 @@
 
 #include "alloc.h"
 #include "grid.h"
+#include "near_list.h"
 #include "primitives.h"
 
 /* Passes over all features per step; a pair still moving things after the
@@ -39,9 +40,14 @@ struct wc_feature_state {
     /// 0 in the first pass (test everything), 1 after (only elements with a
     /// particle the previous pass moved: nothing else can have changed).
     int only_moved;
-    /// Candidate collider triangles of one cloth element.
+    /// Candidate collider features of one cloth element.
     int32_t *found;
     int32_t found_capacity;
+    /// Per collider (by index): the cloth elements near it, while it is
+    /// static (near_list.h).
+    wc_near_list *near;
+    int32_t near_count;
+    int skip_near_lists;
 };
 
 /* Plain comparisons: libm's fmin and fmax are calls (NaN rules), and the
@@ -142,6 +148,8 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
     return s;
 }
 
+void wc_feature_state_keep_near_lists(wc_feature_state *s, int keep) { s->skip_near_lists = !keep; }
+
 void wc_feature_state_destroy(wc_feature_state *s)
 {
     if (!s) return;
@@ -152,6 +160,8 @@ void wc_feature_state_destroy(wc_feature_state *s)
     wc_free(s->moving);
     wc_free(s->carry);
     wc_free(s->found);
+    for (int32_t k = 0; k < s->near_count; ++k) wc_near_list_free(&s->near[k]);
+    wc_free(s->near);
     wc_free(s);
 }
 
@@ -315,22 +325,20 @@ static int vertex_triangle(wc_cloth *c, wc_feature_state *s, int32_t t, const do
     return push_element(c, s, idx, w, 3, n, dot3(end_gap, n), r, v_feature, mu, dt);
 }
 
-/* Collider edge (p, q) against cloth edge e, whose box over the step
- * (grown by r) is cloth_edge_box. */
+/* Collider edge (p, q) against cloth edge e; their boxes over the step
+ * overlap (the edge grid's query saw to it). */
 static int edge_edge(wc_cloth *c, wc_feature_state *s, int32_t e, const double p0[3],
-                     const double p1[3], const double q0[3], const double q1[3],
-                     const double cloth_edge_box[6], double r, double mu, double dt)
+                     const double p1[3], const double q0[3], const double q1[3], double r,
+                     double mu, double dt)
 {
     const int32_t *idx = s->edges + 2 * (size_t)e;
-    double a0[3], b0[3], a1[3], b1[3], sp, u, tc, box[6];
+    double a0[3], b0[3], a1[3], b1[3], sp, u, tc;
     start_of(c, idx[0], a0), start_of(c, idx[1], b0);
     end_of(c, idx[0], a1), end_of(c, idx[1], b1);
     const double *from[4] = {p0, q0, a0, b0}, *to[4] = {p1, q1, a1, b1};
-    const double *ends[4] = {p0, p1, q0, q1};
-    feature_box(ends, 4, 0.0, box);
-    if (!wc_boxes_overlap(box, cloth_edge_box)) return 0; /* cheap: before any narrow phase */
+    int ccd = needs_ccd(largest_motion(from, to, 4), r);
     int hit = wc_segment_segment_closest(p1, q1, a1, b1, &sp, &u) < r * r * (1.0 - SLACK);
-    if (!hit && needs_ccd(largest_motion(from, to, 4), r))
+    if (!hit && ccd)
         hit = wc_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &tc, &sp, &u);
     if (!hit) return 0;
     /* A contact at an end of either edge is a vertex's business (a cloth
@@ -374,31 +382,55 @@ static int32_t candidates(wc_feature_state *s, const wc_grid *grid, const double
     return wc_grid_query(grid, box, s->found, s->found_capacity);
 }
 
+/* The collider features near a cloth element whose box is `box`: from the
+ * near list (its element k) when there is one, else from the grid. A near
+ * list's candidates include more than the grid would give; `exact` then
+ * says the caller must test each against the box. -1 on out-of-memory. */
+static int32_t features_near(wc_feature_state *s, const wc_near_elements *near, int32_t k,
+                             const wc_grid *grid, const double box[6], const int32_t **found)
+{
+    if (near) {
+        *found = near->found + near->start[k];
+        return near->start[k + 1] - near->start[k];
+    }
+    int32_t n = candidates(s, grid, box);
+    *found = s->found;
+    return n;
+}
+
 /* One pass of a collider against the cloth, from the cloth's side: each
  * cloth triangle near the collider asks the collider's vertex grid (built
  * once for a static collider) for the vertices near it, each cloth edge its
- * edge grid for the edges near it. Returns 1 if anything moved, 0 if not,
- * -1 on out-of-memory. */
-static int collider_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col, double r,
-                         double mu, double dt)
+ * edge grid for the edges near it; for a static collider the near list
+ * remembers the answers across steps. Returns 1 if anything moved, 0 if
+ * not, -1 on out-of-memory. */
+static int collider_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col,
+                         const wc_near_list *near, double r, double mu, double dt)
 {
     int moved = 0;
     if (!wc_boxes_overlap(col->bounds, s->bounds)) return 0;
-    for (int32_t t = 0; t < s->triangle_count; ++t) {
+    const wc_near_elements *tris = near ? &near->triangles : NULL, *edges = near ? &near->edges : NULL;
+    int32_t count = tris ? tris->count : s->triangle_count;
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t t = tris ? tris->element[k] : k;
         const double *box = s->boxes + 6 * (size_t)t;
         const int32_t *tri = c->topology.triangles + 3 * (size_t)t;
         if (s->only_moved && !(s->moved[tri[0]] | s->moved[tri[1]] | s->moved[tri[2]])) continue;
         if (!wc_boxes_overlap(box, col->bounds)) continue;
-        int32_t n = candidates(s, &col->vertex_grid, box);
+        const int32_t *found;
+        int32_t n = features_near(s, tris, k, &col->vertex_grid, box, &found);
         if (n < 0) return -1;
-        for (int32_t k = 0; k < n; ++k) {
+        for (int32_t j = 0; j < n; ++j) {
             double v0[3], v1[3];
-            vertex_of(col->current, s->found[k], v0);
-            vertex_of(col->next, s->found[k], v1);
+            if (tris && !wc_boxes_overlap(box, col->vertex_boxes + 6 * (size_t)found[j])) continue;
+            vertex_of(col->current, found[j], v0);
+            vertex_of(col->next, found[j], v1);
             moved |= vertex_triangle(c, s, t, v0, v1, r, mu, dt);
         }
     }
-    for (int32_t e = 0; e < s->edge_count; ++e) {
+    count = edges ? edges->count : s->edge_count;
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t e = edges ? edges->element[k] : k;
         double a0[3], a1[3], b0[3], b1[3], box[6];
         if (s->only_moved && !(s->moved[s->edges[2 * e]] | s->moved[s->edges[2 * e + 1]])) continue;
         start_of(c, s->edges[2 * e], a0), end_of(c, s->edges[2 * e], a1);
@@ -406,19 +438,45 @@ static int collider_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *co
         const double *ends[4] = {a0, a1, b0, b1};
         feature_box(ends, 4, r, box);
         if (!wc_boxes_overlap(box, col->bounds)) continue;
-        int32_t n = candidates(s, &col->edge_grid, box);
+        const int32_t *found;
+        int32_t n = features_near(s, edges, k, &col->edge_grid, box, &found);
         if (n < 0) return -1;
-        for (int32_t k = 0; k < n; ++k) {
-            int32_t id = s->found[k];
+        for (int32_t j = 0; j < n; ++j) {
+            int32_t id = found[j];
+            if (edges && !wc_boxes_overlap(box, col->edge_boxes + 6 * (size_t)id)) continue;
             double p0[3], p1[3], q0[3], q1[3];
             vertex_of(col->current, col->edges[2 * id], p0);
             vertex_of(col->next, col->edges[2 * id], p1);
             vertex_of(col->current, col->edges[2 * id + 1], q0);
             vertex_of(col->next, col->edges[2 * id + 1], q1);
-            moved |= edge_edge(c, s, e, p0, p1, q0, q1, box, r, mu, dt);
+            moved |= edge_edge(c, s, e, p0, p1, q0, q1, r, mu, dt);
         }
     }
     return moved;
+}
+
+/* The near list of collider k, made to hold for this pass; NULL when the
+ * collider moves (its grids are rebuilt every step, so there is nothing to
+ * keep). -1 in *status on out-of-memory. */
+static const wc_near_list *near_list_for(wc_cloth *c, wc_feature_state *s, int32_t k,
+                                         const wc_collider *col, double r_triangles, double r,
+                                         int *failed)
+{
+    *failed = 0;
+    if (!col->grid_static || s->skip_near_lists) return NULL;
+    if (k >= s->near_count) {
+        wc_near_list *grown = wc_alloc_array((size_t)k + 1, sizeof *grown);
+        if (!grown) return *failed = 1, NULL;
+        if (s->near_count) memcpy(grown, s->near, (size_t)s->near_count * sizeof *grown);
+        for (int32_t j = s->near_count; j <= k; ++j) wc_near_list_init(&grown[j]);
+        wc_free(s->near);
+        s->near = grown, s->near_count = k + 1;
+    }
+    wc_near_list *l = &s->near[k];
+    if (wc_near_list_holds(l, c, col, r_triangles, r)) return l;
+    if (wc_near_list_build(l, c, s->edges, s->edge_count, col, r_triangles, r))
+        return *failed = 1, NULL;
+    return l;
 }
 
 wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *const *colliders,
@@ -440,7 +498,10 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
             const wc_collider *col = colliders[k];
             if (!col->is_mesh) continue;
             double r = fmax(h + col->thickness, 1e-6);
-            int result = collider_pass(c, s, col, r, sqrt(c->material.friction * col->friction), dt);
+            int failed;
+            const wc_near_list *near = near_list_for(c, s, k, col, r_max, r, &failed);
+            if (failed) return WC_ERROR_OUT_OF_MEMORY;
+            int result = collider_pass(c, s, col, near, r, sqrt(c->material.friction * col->friction), dt);
             if (result < 0) return WC_ERROR_OUT_OF_MEMORY;
             moved |= result;
         }

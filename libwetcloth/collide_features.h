@@ -25,6 +25,11 @@ typedef struct wc_feature_state wc_feature_state;
 wc_feature_state *wc_feature_state_create(const wc_cloth *cloth);
 void wc_feature_state_destroy(wc_feature_state *state);
 
+/// Whether the pass keeps near lists (near_list.h) of static colliders
+/// across steps (1, the default) or asks the grids every pass (0). The
+/// results are the same either way; tests compare the two.
+void wc_feature_state_keep_near_lists(wc_feature_state *state, int keep);
+
 /// Resolves collider vertices and edges of every mesh collider against the
 /// cloth's motion from (x, y, z) to (nx, ny, nz). Serial and in a fixed
 /// order (collider, vertex, edge, candidate), so deterministic.

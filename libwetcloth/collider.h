@@ -73,6 +73,9 @@ typedef struct wc_collider {
     /// The grid holds boxes of the current positions and needs no rebuild
     /// while the collider does not move.
     int grid_static;
+    /// Counts the builds of the grids, so what was made from them (the
+    /// feature pass' near lists) can tell they changed.
+    int64_t grid_version;
 
     /* Convex colliders. */
     wc_convex_shape convex;

@@ -18,13 +18,8 @@ void wc_grid_free(wc_grid *g)
     wc_free(g->start);
     wc_free(g->items);
     wc_free(g->large);
+    wc_free(g->corner);
     wc_grid_init(g);
-}
-
-int wc_boxes_overlap(const double a[6], const double b[6])
-{
-    return a[0] <= b[3] && b[0] <= a[3] && a[1] <= b[4] && b[1] <= a[4] && a[2] <= b[5] &&
-           b[2] <= a[5];
 }
 
 /* Cell coordinate of a value; clamped so huge coordinates cannot overflow. */
@@ -90,11 +85,18 @@ wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double c
         if (!g->start) return WC_ERROR_OUT_OF_MEMORY;
     }
     g->bucket_mask = (uint32_t)(buckets - 1);
+    if (count > g->corner_capacity) {
+        wc_free(g->corner);
+        g->corner = wc_alloc_array(3 * (size_t)count, sizeof *g->corner);
+        g->corner_capacity = g->corner ? count : 0;
+        if (!g->corner) return WC_ERROR_OUT_OF_MEMORY;
+    }
     memset(g->start, 0, ((size_t)buckets + 1) * sizeof *g->start);
     int64_t entries = 0, large = 0;
     for (int32_t i = 0; i < count; ++i) {
         int32_t lo[3], hi[3];
         cell_range(boxes + 6 * (size_t)i, inv, lo, hi);
+        memcpy(g->corner + 3 * (size_t)i, lo, sizeof lo);
         int64_t cells = cells_in(lo, hi);
         if (cells > MAX_CELLS_PER_ITEM) {
             ++large;
@@ -158,15 +160,27 @@ static int32_t emit(int32_t *out, int32_t n, int32_t capacity, int32_t item)
  * and nothing has to be searched or merged while collecting. A hash
  * collision can put an item into a bucket of a cell it does not touch; the
  * corner test rejects it there, because that cell is not its corner. */
-static int reported_here(const wc_grid *g, const double item[6], const int32_t query_lo[3],
-                         int32_t x, int32_t y, int32_t z)
+static int reported_here(const wc_grid *g, int32_t item, const int32_t query_lo[3], int32_t x,
+                         int32_t y, int32_t z)
 {
-    double inv = 1.0 / g->cell_size;
-    int32_t cx = cell_of(item[0], inv), cy = cell_of(item[1], inv), cz = cell_of(item[2], inv);
-    if (cx < query_lo[0]) cx = query_lo[0];
-    if (cy < query_lo[1]) cy = query_lo[1];
-    if (cz < query_lo[2]) cz = query_lo[2];
+    const int32_t *corner = g->corner + 3 * (size_t)item;
+    int32_t cx = corner[0] > query_lo[0] ? corner[0] : query_lo[0];
+    int32_t cy = corner[1] > query_lo[1] ? corner[1] : query_lo[1];
+    int32_t cz = corner[2] > query_lo[2] ? corner[2] : query_lo[2];
     return cx == x && cy == y && cz == z;
+}
+
+/* A query inside one cell reads one bucket. Its items are unique (an item
+ * is stored once per bucket) and ascending (stored in item order), and the
+ * overlap test drops what a hash collision put there, so it needs neither
+ * the corner test nor sorting. */
+static int32_t query_one_cell(const wc_grid *g, const double box[6], const int32_t cell[3],
+                              int32_t *out, int32_t n, int32_t capacity)
+{
+    uint32_t b = bucket_of(g, cell[0], cell[1], cell[2]);
+    for (int32_t k = g->start[b]; k < g->start[b + 1]; ++k)
+        if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)g->items[k])) n = emit(out, n, capacity, g->items[k]);
+    return n;
 }
 
 int32_t wc_grid_query(const wc_grid *g, const double box[6], int32_t *out, int32_t capacity)
@@ -182,14 +196,20 @@ int32_t wc_grid_query(const wc_grid *g, const double box[6], int32_t *out, int32
             if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)i)) n = emit(out, n, capacity, i);
         return n;
     }
+    if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]) {
+        n = query_one_cell(g, box, lo, out, n, capacity);
+        if (g->large_count && n <= capacity) sort_items(out, n);
+        return n;
+    }
     for (int32_t z = lo[2]; z <= hi[2]; ++z)
         for (int32_t y = lo[1]; y <= hi[1]; ++y)
             for (int32_t x = lo[0]; x <= hi[0]; ++x) {
                 uint32_t b = bucket_of(g, x, y, z);
                 for (int32_t k = g->start[b]; k < g->start[b + 1]; ++k) {
-                    const double *item = g->boxes + 6 * (size_t)g->items[k];
-                    if (wc_boxes_overlap(box, item) && reported_here(g, item, lo, x, y, z))
-                        n = emit(out, n, capacity, g->items[k]);
+                    int32_t item = g->items[k];
+                    if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)item) &&
+                        reported_here(g, item, lo, x, y, z))
+                        n = emit(out, n, capacity, item);
                 }
             }
     if (n <= capacity) sort_items(out, n);

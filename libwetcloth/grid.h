@@ -18,11 +18,15 @@ typedef struct wc_grid {
     uint32_t bucket_mask;
     int32_t *start;
     int32_t *items;
+    /// Per item, the cell holding its lowest corner (3 per item), so a
+    /// query tells in integers from which of its cells an item is reported.
+    int32_t *corner;
     /// Items too large to hash cell by cell; every query tests them.
     int32_t *large;
     int32_t large_count;
     int64_t table_capacity;
     int64_t entry_capacity;
+    int64_t corner_capacity;
 } wc_grid;
 
 /// Empty grid (no memory).
@@ -38,7 +42,12 @@ wc_status wc_grid_build(wc_grid *grid, const double *boxes, int32_t count, doubl
 /// unique, and returns how many there are (which may exceed capacity).
 int32_t wc_grid_query(const wc_grid *grid, const double box[6], int32_t *out, int32_t capacity);
 
-/// Whether two boxes overlap (touching counts).
-int wc_boxes_overlap(const double a[6], const double b[6]);
+/// Whether two boxes overlap (touching counts). Inline: the collision
+/// passes call it for every candidate pair.
+static inline int wc_boxes_overlap(const double a[6], const double b[6])
+{
+    return a[0] <= b[3] && b[0] <= a[3] && a[1] <= b[4] && b[1] <= a[4] && a[2] <= b[5] &&
+           b[2] <= a[5];
+}
 
 #endif

@@ -1,7 +1,10 @@
 /* Collision benchmark: the thesis' Table 3.2 scene and self-collision
  * scaling, each figure measured in this run.
  *
- *   build/tools/bench_collide [threads=1] [seconds=1.0]
+ *   build/tools/bench_collide [threads=1] [seconds=1.0] [size self_collision]
+ *
+ * With size and self_collision (0 or 1) given, only that one configuration
+ * of the Table 3.2 scene runs (for profiling).
  *
  * Table 3.2 scene: an n x n grid cloth, 1 m wide, 0.6 m above the 114-vertex
  * UV sphere (16 segments x 8 rings, radius 0.3 m), falling onto it. Each
@@ -109,6 +112,19 @@ int main(int argc, char **argv)
     if (threads < 1 || !(seconds > 0.0)) {
         fprintf(stderr, "usage: bench_collide [threads>=1] [seconds>0]\n");
         return 2;
+    }
+    if (argc > 4) {
+        int size = atoi(argv[3]), self = atoi(argv[4]);
+        if (size < 2 || (self != 0 && self != 1)) {
+            fprintf(stderr, "usage: bench_collide threads seconds size>=2 self_collision(0|1)\n");
+            return 2;
+        }
+        result r = run(size, self, threads, seconds);
+        printf("%d particles, self-collision %s: %.0f steps/s, %.2f M particle-steps/s, %lld steps, "
+               "%d intersections at end\n",
+               size * size, self ? "on" : "off", r.steps_per_second, r.particle_steps_per_second / 1e6,
+               (long long)r.steps, (int)r.intersections);
+        return 0;
     }
     static const int sizes[3] = {10, 15, 20};
     static const int thesis_on[3] = {62, 15, 6}, thesis_off[3] = {142, 62, 35};
