@@ -27,6 +27,9 @@ void wc_cloth_destroy(wc_cloth *c)
     wc_free(c->contact_prev);
     wc_free(c->stuck);
     wc_free(c->history_override);
+    wc_free(c->self_touched);
+    wc_free(c->adhesive_pairs);
+    wc_free(c->adhesive_data);
     wc_self_state_destroy(c->self);
     wc_feature_state_destroy(c->features);
     wc_topology_free(&c->topology);
@@ -178,6 +181,8 @@ void wc_cloth_apply_material(wc_cloth *c)
     }
     c->stable_dt = estimate_stable_dt(c);
     c->wet_forces = any_wet_force(c);
+    /* pairs found while wet must not act when the cloth is wet again */
+    if (!c->wet_forces) c->adhesive_count = 0;
 }
 
 /* Every link must join two distinct points of the rest shape. */

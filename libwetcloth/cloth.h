@@ -92,6 +92,18 @@ typedef struct wc_cloth {
     int wet_forces;
     /// Scratch for wicking (NULL unless the material wicks).
     double *wetness_next;
+    /// Self-adhesion (wet cloth with self-collision, wetness.c): the
+    /// vertex-face pairs (vertex, triangle) the self-collision answered in
+    /// this step, and whether recording one ran out of memory...
+    int32_t *self_touched;
+    int64_t self_touched_count, self_touched_capacity;
+    int self_touched_failed;
+    /// ...and the pairs that adhere, from the last step: (vertex, triangle)
+    /// and per pair the barycentric weights of the face point (3) and the
+    /// unit normal from the face toward the vertex (3).
+    int32_t *adhesive_pairs;
+    double *adhesive_data;
+    int64_t adhesive_count, adhesive_capacity;
 } wc_cloth;
 
 /// Creates a cloth from a validated description. On failure nothing leaks.

@@ -235,6 +235,15 @@ static int push_element(wc_cloth *c, wc_feature_state *s, const int32_t *idx, co
         for (int d = 0; d < 3; ++d) tangent[d] = rel[d] - vn * n[d];
         double speed = sqrt(dot3(tangent, tangent));
         double cut = speed > 0.0 ? min2(1.0, mu * (-vn) / speed) : 0.0;
+        /* Wet friction (thesis eq. 2.10), as for a particle on a face
+         * (collide.c): in sustained contact the tangential velocity left
+         * after Coulomb is scaled by 1 - w (1 - q), w the element's wetness
+         * at the contact point over its corners that touched in the last
+         * step. Dry cloth keeps exactly the Coulomb cut. */
+        double wet = 0.0;
+        for (int k = 0; k < count; ++k)
+            if (c->contact_prev[idx[k]] != WC_CONTACT_NONE) wet += w[k] * c->wetness[idx[k]];
+        if (wet > 0.0) cut = 1.0 - (1.0 - cut) * (1.0 - wet * (1.0 - c->material.wet_friction));
         for (int d = 0; d < 3; ++d) change[d] = -vn * n[d] - cut * tangent[d];
     }
     for (int k = 0; k < count; ++k) {

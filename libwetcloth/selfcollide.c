@@ -71,6 +71,7 @@
 #include "grid.h"
 #include "parallel.h"
 #include "primitives.h"
+#include "wetness.h"
 
 /* Response passes before the fail-safe. Each pass re-evaluates only what
  * moved, so the later passes are cheap. */
@@ -1526,6 +1527,33 @@ static wc_status failsafe(wc_cloth *c, wc_self_state *s, self_ctx *ctx, double g
     return WC_OK;
 }
 
+/* Wet cloth: the vertex-face pairs that may adhere (wetness.c) are those
+ * within (1 + WC_WET_HOLD_BAND) h at the end of the step whose vertex is in
+ * contact: the contact marks of the responses reach every particle of an
+ * answered pair, vertex or face corner, so which of two touching layers'
+ * pairs the response happened to answer first does not matter. Rest
+ * neighbours (thinner pairs) are the cloth itself, not a second layer. */
+static void note_adhesive(wc_cloth *c, wc_self_state *s, const self_ctx *ctx)
+{
+    double reach = (1.0 + WC_WET_HOLD_BAND) * ctx->h, bary[3];
+    for (int64_t i = 0; i < s->vf_count; ++i) {
+        const int32_t *pr = s->vf + 2 * i, *tri = s->triangles + 3 * (size_t)pr[1];
+        if (c->contact[pr[0]] == WC_CONTACT_NONE) continue;
+        double p[4][3];
+        load(c->nx, c->ny, c->nz, pr[0], p[0]);
+        for (int j = 0; j < 3; ++j) load(c->nx, c->ny, c->nz, tri[j], p[1 + j]);
+        if (!(wc_point_triangle_closest(p[0], p[1], p[2], p[3], bary) < reach * reach)) continue;
+        int32_t ids[4] = {pr[0], tri[0], tri[1], tri[2]};
+        if (s->vf_h[i] < 0.0) s->vf_h[i] = pair_thickness(ctx, rest2_vf(ctx, ids));
+        if (s->vf_h[i] == ctx->h) wc_wet_note_self_contact(c, pr[0], pr[1]);
+    }
+}
+
+double wc_self_thickness(const wc_cloth *c)
+{
+    return max2(c->material.thickness, MIN_THICKNESS * c->self->mean_edge);
+}
+
 wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *stats)
 {
     (void)dt; /* everything works in displacements over the step */
@@ -1533,7 +1561,7 @@ wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *st
     if (!s || s->triangle_count == 0) return WC_OK;
     if (threads < 1) threads = 1;
     self_ctx ctx;
-    ctx.h = max2(c->material.thickness, MIN_THICKNESS * s->mean_edge);
+    ctx.h = wc_self_thickness(c);
     ctx.tol = CCD_TOLERANCE * ctx.h;
     ctx.exclude2 = (REST_EXCLUSION * ctx.h) * (REST_EXCLUSION * ctx.h);
     ctx.rest = s->rest;
@@ -1567,6 +1595,7 @@ wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *st
         rebuild = !still_valid(s, c);
     }
     if (failsafe(c, s, &ctx, g, threads, &reverted)) return WC_ERROR_OUT_OF_MEMORY;
+    if (c->wet_forces) note_adhesive(c, s, &ctx);
     if (stats) {
         stats->cloth_contacts += marked;
         stats->failsafe_particles += reverted;

@@ -24,4 +24,9 @@ void wc_self_state_destroy(wc_self_state *state);
 /// Deterministic for any thread count.
 wc_status wc_self_collide(wc_cloth *cloth, double dt, int threads, wc_step_stats *stats);
 
+/// The thickness self-collision keeps between layers of a cloth that has
+/// self-collision: the material's, but at least a small fraction of the mean
+/// rest edge length.
+double wc_self_thickness(const wc_cloth *cloth);
+
 #endif

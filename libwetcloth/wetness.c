@@ -1,7 +1,10 @@
 #include "wetness.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "alloc.h"
 
 #include "convex.h"
 #include "parallel.h"
@@ -32,14 +35,17 @@ void wc_wet_forces(wc_cloth *c, int threads)
         if (w <= 0.0 || c->pin_slot[i] >= 0) continue;
         double s = m->adhesion * c->topology.area[i] * w;
         double f[3] = {0.0, 0.0, 0.0};
-        if (c->contact[i] != WC_CONTACT_NONE) {
+        if (c->contact[i] == WC_CONTACT_COLLIDER) {
             f[0] = -s * c->normal_x[i], f[1] = -s * c->normal_y[i], f[2] = -s * c->normal_z[i];
-        } else if (m->spread > 0.0) {
+        } else if (c->contact[i] == WC_CONTACT_NONE && m->spread > 0.0) {
             for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
                 int32_t e = c->link_list[k] >= 0 ? c->link_list[k] : ~c->link_list[k];
                 if (e >= stretch_count) continue; /* bend links do not spread */
                 int32_t j = links->a[e] == i ? links->b[e] : links->a[e];
-                if (!c->stuck[j]) continue;
+                /* spreading follows collider contacts only: a pull toward
+                 * another layer of the cloth would have no equal and
+                 * opposite partner */
+                if (!c->stuck[j] || c->contact[j] != WC_CONTACT_COLLIDER) continue;
                 double dx = c->x[i] - c->x[j], dy = c->y[i] - c->y[j], dz = c->z[i] - c->z[j];
                 double d = sqrt(dx * dx + dy * dy + dz * dz);
                 double pull = s * m->spread * (d > links->rest[e] ? links->rest[e] / d : 1.0);
@@ -56,6 +62,132 @@ void wc_wet_forces(wc_cloth *c, int threads)
         c->fx[i] += f[0];
         c->fy[i] += f[1];
         c->fz[i] += f[2];
+    }
+    if (c->adhesive_count) wc_wet_self_adhesion(c, c->fx, c->fy, c->fz);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Self-adhesion                                                            */
+/* ------------------------------------------------------------------------ */
+
+/* Wet cloth touching wet cloth (SPEC 3): the water between two layers pulls
+ * them together with equal and opposite forces. The self-collision's
+ * vertex-face pairs carry it: a vertex v at distance ~h from a point
+ * sum b_k X_k of a triangle of another layer, n the unit normal from that
+ * point to v. The pull F acts as -F n on v and +F b_k n on the corners: the
+ * forces sum to F n (sum b_k - 1) = 0 to rounding, so momentum is kept.
+ * F = adhesion * A_v * w / 2 / n_v, w = the larger of the vertex's and the
+ * face point's wetness (water in the gap comes from either side, as a wet
+ * cloth sticks to a dry collider), n_v the vertex's number of adhesive pairs
+ * (a vertex over an edge of the other layer touches both its triangles).
+ * The 1/2: between two layers both sides' vertices make pairs against the
+ * other's faces, so each patch of contact is counted twice; with it, two
+ * wet layers press together with about the adhesion pressure a wet cloth
+ * has on a collider. Pairs are kept, like collider contacts, while they
+ * stay within (1 + WC_WET_HOLD_BAND) h. Rest neighbours in the cloth (pairs
+ * closer than 2 h in the rest shape) never adhere: they are the cloth
+ * itself, not a second layer. */
+
+void wc_wet_note_self_contact(wc_cloth *c, int32_t v, int32_t t)
+{
+    if (c->self_touched_count == c->self_touched_capacity) {
+        int64_t capacity = c->self_touched_capacity ? 2 * c->self_touched_capacity : 256;
+        int32_t *grown = wc_alloc_array((size_t)capacity, 2 * sizeof *grown);
+        if (!grown) {
+            c->self_touched_failed = 1;
+            return;
+        }
+        if (c->self_touched_count)
+            memcpy(grown, c->self_touched, (size_t)c->self_touched_count * 2 * sizeof *grown);
+        wc_free(c->self_touched);
+        c->self_touched = grown;
+        c->self_touched_capacity = capacity;
+    }
+    c->self_touched[2 * c->self_touched_count] = v;
+    c->self_touched[2 * c->self_touched_count + 1] = t;
+    c->self_touched_count++;
+}
+
+static int compare_pair(const void *pa, const void *pb)
+{
+    const int32_t *p = pa, *q = pb;
+    if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
+    if (p[1] != q[1]) return p[1] < q[1] ? -1 : 1;
+    return 0;
+}
+
+wc_status wc_wet_self_pairs(wc_cloth *c, double h)
+{
+    int64_t old = c->adhesive_count, total = c->self_touched_count + old;
+    if (c->self_touched_failed) {
+        c->self_touched_failed = 0, c->self_touched_count = 0;
+        return WC_ERROR_OUT_OF_MEMORY;
+    }
+    if (total == 0) return WC_OK;
+    /* the answered pairs and last step's adhesive ones, sorted, unique */
+    int32_t *keys = wc_alloc_array((size_t)total, 2 * sizeof *keys);
+    int32_t *pairs = total > c->adhesive_capacity ? wc_alloc_array((size_t)total, 2 * sizeof *pairs) : NULL;
+    double *data = total > c->adhesive_capacity ? wc_alloc_array((size_t)total, 6 * sizeof *data) : NULL;
+    if (!keys || (total > c->adhesive_capacity && (!pairs || !data))) {
+        wc_free(keys), wc_free(pairs), wc_free(data);
+        c->self_touched_count = 0;
+        return WC_ERROR_OUT_OF_MEMORY;
+    }
+    if (c->self_touched_count)
+        memcpy(keys, c->self_touched, (size_t)c->self_touched_count * 2 * sizeof *keys);
+    if (old) memcpy(keys + 2 * c->self_touched_count, c->adhesive_pairs, (size_t)old * 2 * sizeof *keys);
+    c->self_touched_count = 0;
+    if (pairs) {
+        wc_free(c->adhesive_pairs), wc_free(c->adhesive_data);
+        c->adhesive_pairs = pairs, c->adhesive_data = data, c->adhesive_capacity = total;
+    }
+    qsort(keys, (size_t)total, 2 * sizeof *keys, compare_pair);
+    double reach = (1.0 + WC_WET_HOLD_BAND) * h;
+    int64_t kept = 0;
+    for (int64_t k = 0; k < total; ++k) {
+        const int32_t *key = keys + 2 * k;
+        if (k > 0 && key[0] == key[-2] && key[1] == key[-1]) continue;
+        int32_t v = key[0];
+        const int32_t *tri = c->topology.triangles + 3 * (size_t)key[1];
+        double p[3] = {c->nx[v], c->ny[v], c->nz[v]}, corner[3][3], w[3], n[3];
+        for (int j = 0; j < 3; ++j)
+            corner[j][0] = c->nx[tri[j]], corner[j][1] = c->ny[tri[j]], corner[j][2] = c->nz[tri[j]];
+        double d2 = wc_point_triangle_closest(p, corner[0], corner[1], corner[2], w);
+        if (!(d2 < reach * reach) || !(d2 > 0.0)) continue; /* parted, or no direction */
+        double d = sqrt(d2);
+        for (int j = 0; j < 3; ++j) n[j] = (p[j] - (w[0] * corner[0][j] + w[1] * corner[1][j] + w[2] * corner[2][j])) / d;
+        c->adhesive_pairs[2 * kept] = v, c->adhesive_pairs[2 * kept + 1] = key[1];
+        double *out = c->adhesive_data + 6 * kept;
+        for (int j = 0; j < 3; ++j) out[j] = w[j], out[3 + j] = n[j];
+        ++kept;
+    }
+    c->adhesive_count = kept;
+    wc_free(keys);
+    return WC_OK;
+}
+
+void wc_wet_self_adhesion(const wc_cloth *c, double *fx, double *fy, double *fz)
+{
+    const wc_material *m = &c->material;
+    for (int64_t k = 0; k < c->adhesive_count;) {
+        /* the pairs of one vertex are consecutive (sorted by vertex) */
+        int32_t v = c->adhesive_pairs[2 * k];
+        int64_t end = k;
+        while (end < c->adhesive_count && c->adhesive_pairs[2 * end] == v) ++end;
+        double share = 0.5 * m->adhesion * c->topology.area[v] / (double)(end - k);
+        for (; k < end; ++k) {
+            const int32_t *tri = c->topology.triangles + 3 * (size_t)c->adhesive_pairs[2 * k + 1];
+            const double *b = c->adhesive_data + 6 * k, *n = b + 3;
+            double face_w = b[0] * c->wetness[tri[0]] + b[1] * c->wetness[tri[1]] + b[2] * c->wetness[tri[2]];
+            double f = share * (c->wetness[v] > face_w ? c->wetness[v] : face_w);
+            if (!(f > 0.0)) continue;
+            /* (pinned particles ignore their force at integration) */
+            fx[v] -= f * n[0], fy[v] -= f * n[1], fz[v] -= f * n[2];
+            for (int j = 0; j < 3; ++j) {
+                int32_t i = tri[j];
+                fx[i] += f * b[j] * n[0], fy[i] += f * b[j] * n[1], fz[i] += f * b[j] * n[2];
+            }
+        }
     }
 }
 

@@ -27,6 +27,24 @@ void wc_wet_forces(wc_cloth *cloth, int threads);
 void wc_wet_hold_contacts(wc_cloth *cloth, wc_collider *const *colliders, int32_t count,
                           int threads);
 
+/// Self-collision of a wet cloth answered the vertex-face pair (vertex,
+/// triangle) in this step: remember it for self-adhesion. On out-of-memory
+/// sets cloth->self_touched_failed.
+void wc_wet_note_self_contact(wc_cloth *cloth, int32_t vertex, int32_t triangle);
+
+/// After the self-collision of a wet cloth: the pairs that adhere in the
+/// next step, from those it answered and those that adhered in this step
+/// and are still within (1 + WC_WET_HOLD_BAND) h (h the self-collision
+/// thickness), with their face weights and normals at the end of the step.
+/// WC_ERROR_OUT_OF_MEMORY when a buffer could not grow (nothing changed).
+wc_status wc_wet_self_pairs(wc_cloth *cloth, double h);
+
+/// Adds the self-adhesion forces of the cloth's adhesive pairs to fx, fy,
+/// fz (particle arrays): per pair, -F n on the vertex and +F b_k n on the
+/// face's corners (b the face weights), equal and opposite. Serial, in pair
+/// order, so the sums do not depend on the thread count.
+void wc_wet_self_adhesion(const wc_cloth *cloth, double *fx, double *fy, double *fz);
+
 /// After the collisions of a step: marks the stuck particles (wet, in
 /// contact in this step and the one before) and returns their count.
 int32_t wc_wet_mark_stuck(wc_cloth *cloth);

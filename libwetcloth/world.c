@@ -160,6 +160,10 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory in the self-collision of cloth %d; the world keeps its "
                            "last good state", (int)c);
+        if (cl->self && cl->wet_forces && wc_wet_self_pairs(cl, wc_self_thickness(cl)))
+            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                           "out of memory for the self-adhesion of cloth %d; the world keeps its "
+                           "last good state", (int)c);
         long bad = -1;
         for (int axis = 0; axis < 3 && bad < 0; ++axis) {
             const double *v = axis == 0 ? cl->nx : axis == 1 ? cl->ny : cl->nz;
