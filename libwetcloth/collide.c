@@ -3,7 +3,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "collide_features.h"
 #include "convex.h"
+#include "near_list.h"
 #include "parallel.h"
 #include "primitives.h"
 
@@ -278,7 +280,11 @@ typedef struct candidates {
     int32_t found[MAX_CANDIDATES];
 } candidates;
 
-static void query_candidates(candidates *cand, const particle_motion *m, const wc_collider *c, double r)
+/* The grid's answer for cand->box, or the same answer from the near list
+ * (its candidates that meet the box) while the particle is inside the box
+ * the list was made with. */
+static void query_candidates(candidates *cand, const particle_motion *m, const wc_collider *c,
+                             const wc_near_list *near, int32_t particle, double r)
 {
     if (cand->count >= 0) {
         int inside = 1;
@@ -290,15 +296,28 @@ static void query_candidates(candidates *cand, const particle_motion *m, const w
     grow_box(cand->box, m->start);
     grow_box(cand->box, m->end);
     for (int k = 0; k < 3; ++k) cand->box[k] -= 2 * r, cand->box[k + 3] += 2 * r;
+    const int32_t *listed;
+    int32_t listed_count;
+    if (near && wc_near_list_particle(near, c, 2 * r, particle, m->start[0], m->start[1],
+                                      m->start[2], m->end[0], m->end[1], m->end[2], &listed,
+                                      &listed_count)) {
+        cand->count = 0;
+        for (int32_t k = 0; k < listed_count; ++k)
+            if (wc_boxes_overlap(cand->box, c->boxes + 6 * (size_t)listed[k])) {
+                if (cand->count < MAX_CANDIDATES) cand->found[cand->count] = listed[k];
+                cand->count++;
+            }
+        return;
+    }
     cand->count = wc_boxes_overlap(cand->box, c->bounds)
                       ? wc_grid_query(&c->grid, cand->box, cand->found, MAX_CANDIDATES)
                       : 0;
 }
 
-static int mesh_collider(particle_motion *m, const wc_collider *c, candidates *cand, double r,
-                         double mu, double dt)
+static int mesh_collider(particle_motion *m, const wc_collider *c, const wc_near_list *near,
+                         int32_t particle, candidates *cand, double r, double mu, double dt)
 {
-    query_candidates(cand, m, c, r);
+    query_candidates(cand, m, c, near, particle, r);
     int moved = 0;
     if (cand->count <= MAX_CANDIDATES) {
         for (int32_t k = 0; k < cand->count; ++k) moved |= mesh_triangle(m, c, cand->found[k], r, mu, dt);
@@ -371,7 +390,8 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
                 double mu = sqrt(mu_cloth * col->friction);
                 if (col->is_mesh) {
                     if (cand_owner != c) cand.count = -1, cand_owner = c;
-                    moved |= mesh_collider(&m, col, &cand, r, mu, dt);
+                    moved |= mesh_collider(&m, col, wc_feature_state_near_list(cl->features, c), i,
+                                           &cand, r, mu, dt);
                 } else {
                     moved |= convex_collider(&m, col, r, mu, dt);
                 }

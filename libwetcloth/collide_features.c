@@ -150,6 +150,12 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
 
 void wc_feature_state_keep_near_lists(wc_feature_state *s, int keep) { s->skip_near_lists = !keep; }
 
+const wc_near_list *wc_feature_state_near_list(const wc_feature_state *s, int32_t collider)
+{
+    if (!s || s->skip_near_lists || collider >= s->near_count) return NULL;
+    return &s->near[collider];
+}
+
 void wc_feature_state_destroy(wc_feature_state *s)
 {
     if (!s) return;
@@ -482,8 +488,9 @@ static const wc_near_list *near_list_for(wc_cloth *c, wc_feature_state *s, int32
         s->near = grown, s->near_count = k + 1;
     }
     wc_near_list *l = &s->near[k];
-    if (wc_near_list_holds(l, c, col, r_triangles, r)) return l;
-    if (wc_near_list_build(l, c, s->edges, s->edge_count, col, r_triangles, r))
+    /* the particle pass grows its query boxes by twice the contact distance */
+    if (wc_near_list_holds(l, c, col, r_triangles, r, 2 * r)) return l;
+    if (wc_near_list_build(l, c, s->edges, s->edge_count, col, r_triangles, r, 2 * r))
         return *failed = 1, NULL;
     return l;
 }

@@ -30,6 +30,11 @@ void wc_feature_state_destroy(wc_feature_state *state);
 /// results are the same either way; tests compare the two.
 void wc_feature_state_keep_near_lists(wc_feature_state *state, int keep);
 
+/// The near list kept for collider `collider` (by index), or NULL if there
+/// is none; the particle pass (collide.c) reads its particle part.
+const struct wc_near_list *wc_feature_state_near_list(const wc_feature_state *state,
+                                                     int32_t collider);
+
 /// Resolves collider vertices and edges of every mesh collider against the
 /// cloth's motion from (x, y, z) to (nx, ny, nz). Serial and in a fixed
 /// order (collider, vertex, edge, candidate), so deterministic.

@@ -26,8 +26,10 @@ static void elements_free(wc_near_elements *e)
 void wc_near_list_free(wc_near_list *l)
 {
     wc_free(l->particle_boxes);
+    wc_free(l->particle_slot);
     elements_free(&l->triangles);
     elements_free(&l->edges);
+    elements_free(&l->particles);
     wc_near_list_init(l);
 }
 
@@ -36,17 +38,39 @@ static int inside(const double box[6], double x, double y, double z)
     return x >= box[0] && x <= box[3] && y >= box[1] && y <= box[4] && z >= box[2] && z <= box[5];
 }
 
-int wc_near_list_holds(const wc_near_list *l, const wc_cloth *c, const wc_collider *col,
-                       double r_triangles, double r_edges)
+/* Made for this collider, which has not changed since. */
+static int made_for(const wc_near_list *l, const wc_collider *col)
 {
-    if (!l->built || l->collider != col || l->grid_version != col->grid_version ||
-        !col->grid_static || l->r_triangles != r_triangles || l->r_edges != r_edges ||
-        l->particle_count != c->particle_count)
+    return l->built && l->collider == col && l->grid_version == col->grid_version && col->grid_static;
+}
+
+int wc_near_list_holds(const wc_near_list *l, const wc_cloth *c, const wc_collider *col,
+                       double r_triangles, double r_edges, double r_particles)
+{
+    if (!made_for(l, col) || l->r_triangles != r_triangles || l->r_edges != r_edges ||
+        l->r_particles != r_particles || l->particle_count != c->particle_count)
         return 0;
     for (int32_t i = 0; i < c->particle_count; ++i) {
         const double *box = l->particle_boxes + 6 * (size_t)i;
         if (!inside(box, c->x[i], c->y[i], c->z[i]) || !inside(box, c->nx[i], c->ny[i], c->nz[i]))
             return 0;
+    }
+    return 1;
+}
+
+int wc_near_list_particle(const wc_near_list *l, const wc_collider *col, double r_particles,
+                          int32_t i, double sx, double sy, double sz, double ex, double ey,
+                          double ez, const int32_t **found, int32_t *count)
+{
+    if (!made_for(l, col) || l->r_particles != r_particles || i >= l->particle_count) return 0;
+    const double *box = l->particle_boxes + 6 * (size_t)i;
+    if (!inside(box, sx, sy, sz) || !inside(box, ex, ey, ez)) return 0;
+    int32_t k = l->particle_slot[i];
+    if (k < 0) {
+        *found = NULL, *count = 0;
+    } else {
+        *found = l->particles.found + l->particles.start[k];
+        *count = l->particles.start[k + 1] - l->particles.start[k];
     }
     return 1;
 }
@@ -112,14 +136,17 @@ static wc_status list_elements(wc_near_list *l, wc_near_elements *out, const int
 
 wc_status wc_near_list_build(wc_near_list *l, const wc_cloth *c, const int32_t *edges,
                              int32_t edge_count, const wc_collider *col, double r_triangles,
-                             double r_edges)
+                             double r_edges, double r_particles)
 {
     l->built = 0;
-    if (l->particle_count != c->particle_count) {
+    int32_t n = c->particle_count;
+    if (l->particle_count != n) {
         wc_free(l->particle_boxes);
-        l->particle_boxes = wc_alloc_array(6 * (size_t)c->particle_count, sizeof *l->particle_boxes);
-        l->particle_count = l->particle_boxes ? c->particle_count : 0;
-        if (!l->particle_boxes) return WC_ERROR_OUT_OF_MEMORY;
+        wc_free(l->particle_slot);
+        l->particle_boxes = wc_alloc_array(6 * (size_t)n, sizeof *l->particle_boxes);
+        l->particle_slot = wc_alloc_array((size_t)n, sizeof *l->particle_slot);
+        l->particle_count = l->particle_boxes && l->particle_slot ? n : 0;
+        if (!l->particle_count) return WC_ERROR_OUT_OF_MEMORY;
     }
     double margin = MARGIN_CELLS * col->vertex_grid.cell_size;
     for (int32_t i = 0; i < c->particle_count; ++i) {
@@ -133,10 +160,15 @@ wc_status wc_near_list_build(wc_near_list *l, const wc_cloth *c, const int32_t *
     wc_status s = list_elements(l, &l->triangles, c->topology.triangles, 3,
                                 c->topology.triangle_count, &col->vertex_grid, col->bounds, r_triangles);
     if (!s) s = list_elements(l, &l->edges, edges, 2, edge_count, &col->edge_grid, col->bounds, r_edges);
+    /* particle i is element i: the slot array is its own identity map */
+    for (int32_t i = 0; i < n && !s; ++i) l->particle_slot[i] = i;
+    if (!s) s = list_elements(l, &l->particles, l->particle_slot, 1, n, &col->grid, col->bounds, r_particles);
     if (s) return s;
+    for (int32_t i = 0; i < n; ++i) l->particle_slot[i] = -1;
+    for (int32_t k = 0; k < l->particles.count; ++k) l->particle_slot[l->particles.element[k]] = k;
     l->collider = col;
     l->grid_version = col->grid_version;
-    l->r_triangles = r_triangles, l->r_edges = r_edges;
+    l->r_triangles = r_triangles, l->r_edges = r_edges, l->r_particles = r_particles;
     l->built = 1;
     return WC_OK;
 }

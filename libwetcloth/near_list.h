@@ -39,6 +39,7 @@ typedef struct wc_near_list {
     int64_t grid_version;
     double r_triangles;
     double r_edges;
+    double r_particles;
     int built;
     /// Per particle: box (min xyz, max xyz) it must stay in for the lists to
     /// hold: its start and end positions at the build, grown by the margin.
@@ -48,6 +49,10 @@ typedef struct wc_near_list {
     /// cloth edge.
     wc_near_elements triangles;
     wc_near_elements edges;
+    /// Collider triangles near each particle (collide.c), and where each
+    /// particle is in that list (-1: it found none).
+    wc_near_elements particles;
+    int32_t *particle_slot;
 } wc_near_list;
 
 void wc_near_list_init(wc_near_list *list);
@@ -56,14 +61,24 @@ void wc_near_list_free(wc_near_list *list);
 /// Whether the lists still hold for this step's motion (x -> nx) of the
 /// cloth against this collider with these contact distances.
 int wc_near_list_holds(const wc_near_list *list, const wc_cloth *cloth, const wc_collider *collider,
-                       double r_triangles, double r_edges);
+                       double r_triangles, double r_edges, double r_particles);
+
+/// For one particle of the particle pass: whether the list was made for
+/// this collider (unchanged) with this r_particles and the particle is
+/// still inside its box from then; if so, its candidate triangles (a
+/// superset of what the grid gives for any box inside its grown box) in
+/// *found, *count.
+int wc_near_list_particle(const wc_near_list *list, const wc_collider *collider, double r_particles,
+                          int32_t particle, double sx, double sy, double sz, double ex, double ey,
+                          double ez, const int32_t **found, int32_t *count);
 
 /// (Re)builds the lists for a collider whose grids are static: cloth
 /// triangles against its vertex grid (boxes grown by r_triangles), cloth
-/// edges (edges: 2 particles each) against its edge grid (grown by r_edges).
+/// edges (edges: 2 particles each) against its edge grid (grown by
+/// r_edges), particles against its triangle grid (grown by r_particles).
 /// WC_ERROR_OUT_OF_MEMORY on failure (the list is then unbuilt).
 wc_status wc_near_list_build(wc_near_list *list, const wc_cloth *cloth, const int32_t *edges,
                              int32_t edge_count, const wc_collider *collider, double r_triangles,
-                             double r_edges);
+                             double r_edges, double r_particles);
 
 #endif
