@@ -14,14 +14,24 @@ import sys
 import numpy as np
 import pytest
 
-from wetcloth import meshio
+from wetcloth import cli, meshio
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def wetcloth_cli(*args, cwd=None):
+    """python -m wetcloth ARGS in a new process: the real exit status."""
     return subprocess.run([sys.executable, "-m", "wetcloth", *args], capture_output=True,
                           text=True, cwd=cwd, timeout=300)
+
+
+def wetcloth_main(capsys, *args):
+    """The same in this process (faster, for the many bad-input cases):
+    (exit status, stdout, stderr). An exception escaping main() fails the
+    test, as a traceback would fail the one-line check."""
+    status = cli.main(list(args))
+    out, err = capsys.readouterr()
+    return subprocess.CompletedProcess(args, status, out, err)
 
 
 SMALL = {
@@ -224,7 +234,7 @@ BAD = {
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
-def test_bad_scene(tmp_path, case):
+def test_bad_scene(tmp_path, capsys, case):
     scene, files, expected = BAD[case]
     for name, text in files.items():
         (tmp_path / name).write_text(text)
@@ -237,7 +247,7 @@ def test_bad_scene(tmp_path, case):
         path = write_scene(tmp_path, scene)
     before = listing(tmp_path)
     out = tmp_path / "out"
-    r = wetcloth_cli("run", str(path), "--out", str(out), "--no-progress")
+    r = wetcloth_main(capsys, "run", str(path), "--out", str(out), "--no-progress")
     assert r.returncode == 2, (case, r.returncode, r.stdout, r.stderr)
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1, r.stderr  # one message, no traceback
