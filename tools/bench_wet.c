@@ -1,0 +1,181 @@
+/* Cost of wetness on the thesis drape scene, wet against dry, side by side
+ * in one run.
+ *
+ *   build/tools/bench_wet [threads=1] [repeats=3] [sizes...=20]
+ *
+ * Scene: an n x n grid cloth (default material), 1 m wide, 0.6 m above the
+ * 114-vertex UV sphere (16 segments x 8 rings, radius 0.3 m), falling onto
+ * it for 2 s in frames of 1/24 s (the thesis' Fig. 3.2-3.4 and Table 3.2
+ * scene). Configurations:
+ *   plain  dry cloth whose material has every wet parameter zeroed;
+ *   dry    dry cloth (w = 0) with the default wet material: must cost the
+ *          same as plain (wetness off costs nothing);
+ *   wet    soaked cloth (w = 1), default wet material: adhesion, spreading,
+ *          wet friction, contact hold, stuck flags, wet mass and softening.
+ * All three take the same steps: the substep count that automatic
+ * substepping picks for the dry cloth, so "wet / dry" is the cost per step.
+ * A soaked cloth is heavier and softer, so its own stable step is 1.69 x
+ * longer and automatic substepping gives it 1.69 x fewer steps per frame:
+ *   wet-auto  the soaked cloth with automatic substeps; "wet-auto / dry" is
+ *             the cost per frame as a user sees it.
+ * Per step, the wet cloth also costs more because more of it touches the
+ * sphere (it wraps it), which is collision work the dry cloth does not
+ * have; the wet code itself (wetness.c) is a few per cent of a wet step
+ * (docs/benchmarks.md, perf).
+ * The configurations run interleaved, `repeats` times each; the figure is
+ * the fastest run of each (the least disturbed by other load), in
+ * microseconds per step, and the ratio wet / dry of those. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "wetcloth.h"
+
+#define PI 3.14159265358979323846
+#define FRAMES 48
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void check(wc_status s, const wc_world *w, const char *what)
+{
+    if (s == WC_OK) return;
+    fprintf(stderr, "%s failed: %s: %s\n", what, wc_status_name(s), w ? wc_world_last_error(w) : "");
+    exit(1);
+}
+
+/* The thesis' solid: UV sphere, 16 segments x 8 rings = 114 vertices. */
+static void add_sphere(wc_world *w)
+{
+    double v[3 * 114];
+    int32_t t[3 * 224], n = 0, k = 0, seg = 16, rings = 8, col;
+    v[0] = v[1] = 0.0, v[2] = 0.3, n = 1;
+    for (int32_t j = 1; j < rings; ++j)
+        for (int32_t i = 0; i < seg; ++i, ++n) {
+            double polar = PI * j / rings, az = 2.0 * PI * i / seg;
+            v[3 * n] = 0.3 * sin(polar) * cos(az);
+            v[3 * n + 1] = 0.3 * sin(polar) * sin(az);
+            v[3 * n + 2] = 0.3 * cos(polar);
+        }
+    v[3 * n] = v[3 * n + 1] = 0.0, v[3 * n + 2] = -0.3;
+    int32_t bottom = n++, base = 1 + (rings - 2) * seg;
+    for (int32_t i = 0; i < seg; ++i) t[k++] = 0, t[k++] = 1 + i, t[k++] = 1 + (i + 1) % seg;
+    for (int32_t j = 0; j + 2 < rings; ++j)
+        for (int32_t i = 0; i < seg; ++i) {
+            int32_t a = 1 + j * seg + i, b = 1 + j * seg + (i + 1) % seg;
+            t[k++] = a, t[k++] = a + seg, t[k++] = b;
+            t[k++] = b, t[k++] = a + seg, t[k++] = b + seg;
+        }
+    for (int32_t i = 0; i < seg; ++i) t[k++] = bottom, t[k++] = base + (i + 1) % seg, t[k++] = base + i;
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertices = v, d.vertex_count = n, d.triangles = t, d.triangle_count = k / 3;
+    check(wc_world_add_mesh_collider(w, &d, &col), w, "add sphere");
+}
+
+enum { PLAIN, DRY, WET, WET_AUTO, CONFIGS };
+static const char *const names[CONFIGS] = {"plain", "dry", "wet", "wet-auto"};
+
+static wc_world *scene(int size, int config, int threads, int32_t *cloth)
+{
+    wc_world_def wd = wc_world_def_default();
+    wd.thread_count = threads;
+    wc_world *w = NULL;
+    wc_message msg;
+    if (wc_world_create(&wd, &w, &msg) != WC_OK) {
+        fprintf(stderr, "wc_world_create: %s\n", msg.text);
+        exit(1);
+    }
+    add_sphere(w);
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = size;
+    g.center[2] = 0.6;
+    if (config == PLAIN) {
+        g.material.adhesion = 0.0, g.material.spread = 0.0, g.material.wet_friction = 1.0;
+        g.material.wet_mass_gain = 0.0, g.material.wet_softening = 0.0;
+    }
+    g.wetness = config >= WET ? 1.0 : 0.0;
+    check(wc_world_add_grid_cloth(w, &g, cloth), w, "add cloth");
+    return w;
+}
+
+typedef struct result {
+    double seconds;
+    int64_t steps;
+    int32_t contacts, stuck, intersections;
+} result;
+
+static result run(int size, int config, int threads, int32_t substeps)
+{
+    int32_t cloth;
+    wc_world *w = scene(size, config, threads, &cloth);
+    result r = {0.0, 0, 0, 0, 0};
+    double t0 = now();
+    for (int f = 0; f < FRAMES; ++f) {
+        check(wc_world_advance(w, 1.0 / 24, substeps), w, "advance");
+        r.steps += wc_world_last_substeps(w);
+    }
+    r.seconds = now() - t0;
+    wc_step_stats st = wc_world_get_stats(w);
+    r.contacts = st.collider_contacts, r.stuck = st.stuck_particles;
+    wc_intersection_counts ic;
+    check(wc_world_count_intersections(w, &ic), w, "count intersections");
+    r.intersections = ic.cloth_cloth + ic.cloth_collider;
+    wc_world_destroy(w);
+    return r;
+}
+
+int main(int argc, char **argv)
+{
+    int threads = argc > 1 ? atoi(argv[1]) : 1, repeats = argc > 2 ? atoi(argv[2]) : 3;
+    int default_sizes[1] = {20}, *sizes = default_sizes, size_count = 1;
+    int given[16];
+    if (argc > 3) {
+        size_count = argc - 3 > 16 ? 16 : argc - 3;
+        for (int k = 0; k < size_count; ++k) given[k] = atoi(argv[3 + k]);
+        sizes = given;
+    }
+    if (threads < 1 || repeats < 1) {
+        fprintf(stderr, "usage: bench_wet [threads>=1] [repeats>=1] [sizes...]\n");
+        return 2;
+    }
+    printf("Thesis drape (n x n cloth onto the 114-vertex sphere, %d frames = %.1f s), %d thread%s,\n"
+           "fastest of %d interleaved runs per configuration; plain, dry and wet take the same steps,\n"
+           "wet-auto its own (automatic) substeps:\n\n",
+           FRAMES, FRAMES / 24.0, threads, threads == 1 ? "" : "s", repeats);
+    printf("| n x n | steps | plain us/step | dry us/step | wet us/step | dry / plain | wet / dry "
+           "(per step) | wet-auto steps | wet-auto / dry (per frame) | wet: stuck, contacts at the end |\n");
+    printf("|---|---|---|---|---|---|---|---|---|---|\n");
+    for (int k = 0; k < size_count; ++k) {
+        int size = sizes[k];
+        int32_t cloth;
+        wc_world *w = scene(size, DRY, threads, &cloth);
+        int32_t substeps = (int32_t)ceil(1.0 / 24 / (wc_world_def_default().substep_safety * wc_world_stable_dt(w)));
+        wc_world_destroy(w);
+        double best[CONFIGS];
+        result last[CONFIGS];
+        for (int c = 0; c < CONFIGS; ++c) best[c] = INFINITY;
+        for (int rep = 0; rep < repeats; ++rep)
+            for (int c = 0; c < CONFIGS; ++c) {
+                last[c] = run(size, c, threads, c == WET_AUTO ? 0 : substeps);
+                if (last[c].seconds < best[c]) best[c] = last[c].seconds;
+            }
+        for (int c = 0; c < CONFIGS; ++c)
+            if (last[c].intersections)
+                fprintf(stderr, "note: %s %dx%d ends with %d intersecting triangle pairs (self-collision "
+                        "is off in this scene)\n", names[c], size, size, last[c].intersections);
+        double us = 1e6 / (double)last[DRY].steps;
+        printf("| %d x %d | %lld | %.1f | %.1f | %.1f | %.3f | %.3f | %lld | %.3f | %d, %d of %d |\n", size,
+               size, (long long)last[DRY].steps, best[PLAIN] * us, best[DRY] * us, best[WET] * us,
+               best[DRY] / best[PLAIN], best[WET] / best[DRY], (long long)last[WET_AUTO].steps,
+               best[WET_AUTO] / best[DRY], last[WET].stuck, last[WET].contacts, size * size);
+        fflush(stdout);
+    }
+    return 0;
+}
