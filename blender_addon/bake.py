@@ -1,0 +1,478 @@
+"""Baking: reads the Blender scene, runs libwetcloth through the `wetcloth`
+package frame by frame, writes a PC2 cache and hooks up a Mesh Cache
+modifier. No physics here: every position comes from the library.
+
+Coordinates: the simulation runs in world space (1 Blender unit = 1 m);
+the cache holds object-local coordinates, so the baked motion plays back
+under the object's own (possibly animated) transform.
+"""
+
+import ctypes
+import os
+import time
+
+import bpy
+import numpy as np
+
+from . import props
+
+MODIFIER_NAME = "Wet Cloth Cache"
+WETNESS_ATTRIBUTE = "wet_cloth_wetness"
+STUCK_ATTRIBUTE = "wet_cloth_stuck"
+
+
+class BakeError(Exception):
+    """A problem to tell the user about (reported, never a traceback)."""
+
+
+# ---------------------------------------------------------------------------
+# The library
+
+_wetcloth = None
+
+
+def _preload_bundled(folder):
+    """The zip bundles the shared libraries libwetcloth needs besides libc
+    (libccd, libgomp). The system's copy is used when it has one; the
+    bundled copy otherwise, loaded globally so that libwetcloth finds it."""
+    if not os.path.isdir(folder):
+        return
+    for name in sorted(os.listdir(folder)):
+        try:
+            ctypes.CDLL(name, mode=ctypes.RTLD_GLOBAL)
+        except OSError:
+            ctypes.CDLL(os.path.join(folder, name), mode=ctypes.RTLD_GLOBAL)
+
+
+def load_wetcloth():
+    """The `wetcloth` package: the copy inside this add-on (the installed
+    extension), else one installed in Blender's Python."""
+    global _wetcloth
+    if _wetcloth is not None:
+        return _wetcloth
+    here = os.path.dirname(os.path.abspath(__file__))
+    try:
+        if os.path.isdir(os.path.join(here, "wetcloth")):
+            _preload_bundled(os.path.join(here, "wetcloth", "libs"))
+            from . import wetcloth
+            from .wetcloth import meshio  # noqa: F401 (the PC2 writer)
+        else:
+            import wetcloth
+            import wetcloth.meshio  # noqa: F401
+    except (ImportError, OSError) as e:
+        raise BakeError("cannot load libwetcloth: %s" % e) from None
+    _wetcloth = wetcloth
+    return wetcloth
+
+
+# ---------------------------------------------------------------------------
+# Reading meshes
+
+
+def _matrix(m):
+    return np.array(m, dtype=np.float64).reshape(4, 4)
+
+
+def _to_world(local, matrix):
+    return local @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def _to_local(world, matrix):
+    inv = np.linalg.inv(matrix)
+    return world @ inv[:3, :3].T + inv[:3, 3]
+
+
+def _positions(mesh):
+    co = np.empty(3 * len(mesh.vertices), dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3).astype(np.float64)
+
+
+def cloth_faces(mesh):
+    """(F, 4) faces for the library: triangles and quads as they are
+    (a last index of -1 makes a triangle), other polygons as Blender
+    triangulates them."""
+    sizes = np.empty(len(mesh.polygons), dtype=np.int32)
+    starts = np.empty(len(mesh.polygons), dtype=np.int32)
+    mesh.polygons.foreach_get("loop_total", sizes)
+    mesh.polygons.foreach_get("loop_start", starts)
+    loops = np.empty(len(mesh.loops), dtype=np.int32)
+    mesh.loops.foreach_get("vertex_index", loops)
+    faces = []
+    for size in (3, 4):
+        sel = np.flatnonzero(sizes == size)
+        if sel.size:
+            idx = loops[starts[sel, None] + np.arange(size)[None, :]]
+            if size == 3:
+                idx = np.concatenate([idx, np.full((idx.shape[0], 1), -1, np.int32)], axis=1)
+            faces.append(idx)
+    if np.any(sizes > 4):
+        mesh.calc_loop_triangles()
+        tri = np.empty(3 * len(mesh.loop_triangles), dtype=np.int32)
+        poly = np.empty(len(mesh.loop_triangles), dtype=np.int32)
+        mesh.loop_triangles.foreach_get("vertices", tri)
+        mesh.loop_triangles.foreach_get("polygon_index", poly)
+        tri = tri.reshape(-1, 3)[sizes[poly] > 4]
+        faces.append(np.concatenate([tri, np.full((tri.shape[0], 1), -1, np.int32)], axis=1))
+    if not faces:
+        return np.zeros((0, 4), dtype=np.int32)
+    return np.concatenate(faces).astype(np.int32)
+
+
+def group_weights(ob, name):
+    """(n,) weights of vertex group `name`, 0 outside it."""
+    group = ob.vertex_groups.get(name)
+    if group is None:
+        raise BakeError("%s has no vertex group %r" % (ob.name, name))
+    gi = group.index
+    w = np.zeros(len(ob.data.vertices))
+    for v in ob.data.vertices:
+        for g in v.groups:
+            if g.group == gi:
+                w[v.index] = g.weight
+                break
+    return w
+
+
+def _is_collider(o):
+    return (o.collision is not None and o.collision.use and
+            any(m.type == "COLLISION" and m.show_viewport for m in o.modifiers))
+
+
+def find_colliders(scene, view_layer, settings, cloth_ob):
+    pool = (settings.collision_collection.all_objects if settings.collision_collection
+            else scene.objects)
+    return [o for o in pool
+            if o is not cloth_ob and _is_collider(o) and view_layer.objects.get(o.name) == o]
+
+
+def _evaluated_mesh(ob, depsgraph, matrix=None):
+    """(world vertices (n, 3), triangles (T, 3)) of the evaluated object."""
+    ev = ob.evaluated_get(depsgraph)
+    mesh = ev.to_mesh()
+    try:
+        mesh.calc_loop_triangles()
+        v = _positions(mesh)
+        t = np.empty(3 * len(mesh.loop_triangles), dtype=np.int32)
+        mesh.loop_triangles.foreach_get("vertices", t)
+        m = _matrix(ev.matrix_world if matrix is None else matrix)
+    finally:
+        ev.to_mesh_clear()
+    return _to_world(v, m), t.reshape(-1, 3)
+
+
+# ---------------------------------------------------------------------------
+# Paths
+
+
+def cache_paths(ob, settings):
+    """(folder as given, absolute folder, absolute cache file)."""
+    given = settings.cache_dir.strip()
+    if not given:
+        raise BakeError("the cache folder is empty: choose one in the Wet Cloth panel")
+    if given.startswith("//") and not bpy.data.filepath:
+        raise BakeError("the cache folder %r is relative to the .blend file, which is not "
+                        "saved yet: save the file or choose an absolute folder" % given)
+    folder = os.path.normpath(bpy.path.abspath(given))
+    name = bpy.path.clean_name(ob.name) + ".pc2"
+    return given, folder, os.path.join(folder, name)
+
+
+def _check_folder(folder):
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as e:
+        raise BakeError("cannot create the cache folder %s: %s" % (folder, e.strerror or e))
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise BakeError("cannot write into the cache folder %s" % folder)
+
+
+# ---------------------------------------------------------------------------
+# The bake
+
+
+class Baker:
+    """One bake of one object: start(), step() until done, then finish();
+    abort() at any point leaves the previous bake as it was."""
+
+    def __init__(self, context, ob):
+        self.scene = context.scene
+        self.view_layer = context.view_layer
+        self.ob = ob
+        self.settings = ob.wet_cloth
+        self.world = None
+        self.writer = None
+        self.tmp_path = None
+        self.hidden_modifiers = []
+        self.frame_before = self.scene.frame_current
+        self.done = False
+        self.started = time.perf_counter()
+
+    # setup ------------------------------------------------------------------
+
+    def start(self):
+        ob, s, scene = self.ob, self.settings, self.scene
+        if ob.type != "MESH":
+            raise BakeError("%s is not a mesh (it is a %s): Wet Cloth bakes mesh objects"
+                            % (ob.name, ob.type.lower()))
+        if not s.enabled:
+            raise BakeError("Wet Cloth is not enabled on %s: tick it in Physics > Wet Cloth"
+                            % ob.name)
+        mesh = ob.data
+        if len(mesh.polygons) == 0:
+            raise BakeError("%s has no faces: a cloth needs a mesh with faces" % ob.name)
+        self.start_frame, self.end_frame = props.frame_range(s, scene)
+        if self.end_frame <= self.start_frame:
+            raise BakeError("the frame range %d to %d is empty: the end must come after the "
+                            "start" % (self.start_frame, self.end_frame))
+        self.frame_count = self.end_frame - self.start_frame + 1
+        self.frame = self.start_frame
+        self.frame_dt = scene.render.fps_base / scene.render.fps
+        self.given_dir, self.folder, self.path = cache_paths(ob, s)
+
+        n = len(mesh.vertices)
+        faces = cloth_faces(mesh)
+        wet = np.full(n, float(s.wetness))
+        if s.wetness_group:
+            wet *= np.clip(group_weights(ob, s.wetness_group), 0.0, 1.0)
+        self.pins = (np.flatnonzero(group_weights(ob, s.pin_group) > 0.0).astype(np.int32)
+                     if s.pin_group else np.zeros(0, np.int32))
+
+        self.colliders = []
+        if s.use_colliders:
+            self.colliders = find_colliders(scene, self.view_layer, s, ob)
+            if not self.colliders:
+                where = ("in the collection %r" % s.collision_collection.name
+                         if s.collision_collection else "in the scene")
+                raise BakeError("nothing to collide with: no object %s has Collision physics; "
+                                "add it to an object (Physics > Collision) or turn off Object "
+                                "Collisions" % where)
+        _check_folder(self.folder)
+
+        wetcloth = load_wetcloth()
+        self.wetcloth = wetcloth
+        material = wetcloth.Material(**props.material_kwargs(s))
+
+        # The cloth's own motion (pins) is read from the mesh as evaluated
+        # without this add-on's cache and what comes after it.
+        self._hide_cache_modifiers()
+        scene.frame_set(self.start_frame)
+        depsgraph = self._depsgraph()
+        start_world = self._cloth_world_positions(depsgraph)
+
+        gravity = tuple(scene.gravity) if scene.use_gravity else (0.0, 0.0, 0.0)
+        try:
+            self.world = wetcloth.World(gravity=gravity)
+            self.cloth = self.world.add_cloth(start_world, faces, material=material,
+                                              wetness=wet, self_collision=s.self_collision)
+            if self.pins.size:
+                self.cloth.pin(self.pins)
+            self.sim_colliders = []
+            for o in self.colliders:
+                v, t = _evaluated_mesh(o, depsgraph)
+                if t.shape[0] == 0:
+                    raise BakeError("collider %s has no faces" % o.name)
+                c = o.collision
+                self.sim_colliders.append(self.world.add_mesh_collider(
+                    v, t, thickness=float(c.thickness_outer),
+                    friction=min(10.0, float(c.cloth_friction) / 10.0)))
+        except wetcloth.WetclothError as e:
+            raise BakeError(str(e)) from None
+
+        self.tmp_path = os.path.join(self.folder, ".%s.%d.tmp" % (os.path.basename(self.path),
+                                                                  os.getpid()))
+        try:
+            self.writer = wetcloth.meshio.PC2Writer(self.tmp_path, n, self.frame_count,
+                                                    start=float(self.start_frame))
+        except OSError as e:
+            raise BakeError("cannot write the cache %s: %s" % (self.tmp_path, e.strerror or e))
+        self._write_frame(start_world, self.ob.matrix_world)
+        self.substeps = 0
+
+    def _depsgraph(self):
+        return bpy.context.evaluated_depsgraph_get()
+
+    def _hide_cache_modifiers(self):
+        mods = list(self.ob.modifiers)
+        for i, m in enumerate(mods):
+            if m.type == "MESH_CACHE" and m.name == MODIFIER_NAME:
+                for later in mods[i:]:
+                    if later.show_viewport:
+                        later.show_viewport = False
+                        self.hidden_modifiers.append(later.name)
+                break
+
+    def _restore_modifiers(self):
+        for name in self.hidden_modifiers:
+            m = self.ob.modifiers.get(name)
+            if m is not None:
+                m.show_viewport = True
+        self.hidden_modifiers = []
+
+    def _cloth_world_positions(self, depsgraph):
+        ev = self.ob.evaluated_get(depsgraph)
+        n = len(self.ob.data.vertices)
+        mesh = ev.to_mesh()
+        try:
+            if len(mesh.vertices) != n:
+                raise BakeError(
+                    "the modifiers of %s change its vertex count (%d, the mesh has %d): move "
+                    "them below the %r modifier or apply them" % (self.ob.name,
+                                                                  len(mesh.vertices), n,
+                                                                  MODIFIER_NAME))
+            v = _positions(mesh)
+        finally:
+            ev.to_mesh_clear()
+        self.matrix = _matrix(ev.matrix_world)
+        return _to_world(v, self.matrix)
+
+    def _write_frame(self, world_positions, matrix):
+        local = _to_local(world_positions, _matrix(matrix))
+        self.writer.write(local)
+
+    # stepping ---------------------------------------------------------------
+
+    def step(self):
+        """Simulates and writes the next frame."""
+        if self.done:
+            return
+        self.frame += 1
+        self.scene.frame_set(self.frame)
+        depsgraph = self._depsgraph()
+        try:
+            for o, c in zip(self.colliders, self.sim_colliders):
+                v, _t = _evaluated_mesh(o, depsgraph)
+                if v.shape[0] != c.vertices.shape[0]:
+                    raise BakeError("collider %s changed its vertex count at frame %d (%d, was "
+                                    "%d): colliders must keep their topology" %
+                                    (o.name, self.frame, v.shape[0], c.vertices.shape[0]))
+                c.set_vertices(v)
+            if self.pins.size:
+                targets = self._cloth_world_positions(depsgraph)[self.pins]
+                self.cloth.set_pin_targets(targets)
+            else:
+                self.matrix = _matrix(self.ob.evaluated_get(depsgraph).matrix_world)
+            substeps = 0 if self.settings.substeps_auto else self.settings.substeps
+            self.substeps += self.world.advance(self.frame_dt, substeps)
+            positions = self.cloth.positions
+        except self.wetcloth.WetclothError as e:
+            raise BakeError("frame %d: %s" % (self.frame, e)) from None
+        self._write_frame(positions, self.matrix)
+        if self.frame >= self.end_frame:
+            self.done = True
+
+    @property
+    def progress(self):
+        return self.frame - self.start_frame + 1
+
+    # ending -----------------------------------------------------------------
+
+    def finish(self):
+        """Puts the new cache in place, then the modifier and attributes."""
+        ob, s = self.ob, self.settings
+        self.writer.close()
+        self.writer = None
+        previous = bpy.path.abspath(s.cache_file) if s.cache_file else ""
+        os.replace(self.tmp_path, self.path)
+        self.tmp_path = None
+        if previous and os.path.normpath(previous) != self.path and os.path.isfile(previous):
+            try:
+                os.remove(previous)
+            except OSError:
+                pass
+        wetness = self.cloth.wetness
+        stuck = self.cloth.stuck.astype(np.float64)
+        elapsed = time.perf_counter() - self.started
+        frames = self.frame_count - 1
+        self.world.close()
+        self._restore_modifiers()
+
+        file_setting = self.path
+        if self.given_dir.startswith("//"):
+            file_setting = bpy.path.relpath(self.path)
+        mod = ob.modifiers.get(MODIFIER_NAME)
+        if mod is None or mod.type != "MESH_CACHE":
+            mod = ob.modifiers.new(MODIFIER_NAME, "MESH_CACHE")
+        mod.cache_format = "PC2"
+        mod.filepath = file_setting
+        mod.frame_start = float(self.start_frame)
+        mod.frame_scale = 1.0
+        mod.play_mode = "SCENE"
+        mod.time_mode = "FRAME"
+        mod.deform_mode = "OVERWRITE"
+        mod.interpolation = "LINEAR"
+        mod.forward_axis = "POS_Y"
+        mod.up_axis = "POS_Z"
+        mod.factor = 1.0
+        mod.show_viewport = True
+        mod.show_render = True
+
+        set_attribute(ob.data, WETNESS_ATTRIBUTE, wetness)
+        set_attribute(ob.data, STUCK_ATTRIBUTE, stuck)
+
+        s.cache_file = file_setting
+        s.baked_frames = self.frame_count
+        s.baked_start = self.start_frame
+        s.bake_info = "%d frames in %.1f s, %.1f substeps per frame" % (
+            self.frame_count, elapsed, self.substeps / max(1, frames))
+        self.scene.frame_set(self.frame_before)
+        ob.update_tag()
+
+    def abort(self):
+        """Drops what this bake wrote; the previous bake stays."""
+        if self.writer is not None:
+            try:
+                self.writer.file.close()
+            except OSError:
+                pass
+            self.writer = None
+        if self.tmp_path and os.path.exists(self.tmp_path):
+            try:
+                os.remove(self.tmp_path)
+            except OSError:
+                pass
+        self.tmp_path = None
+        if self.world is not None:
+            self.world.close()
+        self._restore_modifiers()
+        self.scene.frame_set(self.frame_before)
+
+
+def set_attribute(mesh, name, values):
+    a = mesh.attributes.get(name)
+    if a is not None and (a.data_type != "FLOAT" or a.domain != "POINT"):
+        mesh.attributes.remove(a)
+        a = None
+    if a is None:
+        a = mesh.attributes.new(name, "FLOAT", "POINT")
+    a.data.foreach_set("value", np.asarray(values, dtype=np.float32))
+
+
+def free_bake(ob):
+    """Removes the modifier, the cache file and the attributes. Returns what
+    was removed, as words."""
+    s = ob.wet_cloth
+    removed = []
+    mod = ob.modifiers.get(MODIFIER_NAME)
+    if mod is not None and mod.type == "MESH_CACHE":
+        ob.modifiers.remove(mod)
+        removed.append("modifier")
+    if s.cache_file:
+        path = bpy.path.abspath(s.cache_file)
+        if os.path.isfile(path):
+            try:
+                os.remove(path)
+                removed.append("cache")
+            except OSError as e:
+                raise BakeError("cannot remove the cache %s: %s" % (path, e.strerror or e))
+    if ob.type == "MESH":
+        for name in (WETNESS_ATTRIBUTE, STUCK_ATTRIBUTE):
+            a = ob.data.attributes.get(name)
+            if a is not None:
+                ob.data.attributes.remove(a)
+                if "attributes" not in removed:
+                    removed.append("attributes")
+    s.cache_file = ""
+    s.baked_frames = 0
+    s.bake_info = ""
+    return removed
