@@ -27,9 +27,8 @@ struct wc_feature_state {
     int32_t *edges;
     /// The 3 edge ids of each triangle.
     int32_t *triangle_edges;
-    /// Per triangle: box over the step, grown by the contact distance.
-    double *boxes;
-    double bounds[6];
+    /// Largest contact distance of the colliders in the running call.
+    double r_max;
     /// Particles moved by the previous pass, and by the one being run (the
     /// last one's are what the fail-safe sends back).
     uint8_t *moved;
@@ -115,13 +114,12 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
     int32_t *entries = wc_alloc_array(9 * (size_t)nt, sizeof *entries);
     s->edges = wc_alloc_array(6 * (size_t)nt, sizeof *s->edges);
     s->triangle_edges = wc_alloc_array(3 * (size_t)nt, sizeof *s->triangle_edges);
-    s->boxes = wc_alloc_array(6 * (size_t)nt, sizeof *s->boxes);
     s->moved = wc_alloc_array((size_t)c->particle_count, sizeof *s->moved);
     s->moving = wc_alloc_array((size_t)c->particle_count, sizeof *s->moving);
     s->carry = wc_alloc_array(3 * (size_t)c->particle_count, sizeof *s->carry);
     s->found_capacity = 256;
     s->found = wc_alloc_array((size_t)s->found_capacity, sizeof *s->found);
-    if (!entries || !s->edges || !s->triangle_edges || !s->boxes || !s->moved || !s->moving ||
+    if (!entries || !s->edges || !s->triangle_edges || !s->moved || !s->moving ||
         !s->carry || !s->found) {
         wc_free(entries);
         wc_feature_state_destroy(s);
@@ -161,7 +159,6 @@ void wc_feature_state_destroy(wc_feature_state *s)
     if (!s) return;
     wc_free(s->edges);
     wc_free(s->triangle_edges);
-    wc_free(s->boxes);
     wc_free(s->moved);
     wc_free(s->moving);
     wc_free(s->carry);
@@ -171,29 +168,40 @@ void wc_feature_state_destroy(wc_feature_state *s)
     wc_free(s);
 }
 
-/* Boxes of the cloth's triangles over the step, grown by r, and their union. */
-static void box_triangles(wc_feature_state *s, const wc_cloth *c, double r)
+/* Box of cloth triangle `tri` over the step (its corners' start and end
+ * positions as they are now), grown by r. Made when used, not once per
+ * call: the passes move particles, and a box from before they did could
+ * miss what the move brought near. */
+static void triangle_box(const wc_cloth *c, const int32_t *tri, double r, double box[6])
 {
-    const int32_t *tri = c->topology.triangles;
-    for (int k = 0; k < 3; ++k) s->bounds[k] = INFINITY, s->bounds[k + 3] = -INFINITY;
-    for (int32_t t = 0; t < s->triangle_count; ++t) {
-        double *box = s->boxes + 6 * (size_t)t;
-        for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
-        for (int k = 0; k < 3; ++k) {
-            double p[2][3];
-            start_of(c, tri[3 * t + k], p[0]);
-            end_of(c, tri[3 * t + k], p[1]);
-            for (int e = 0; e < 2; ++e)
-                for (int d = 0; d < 3; ++d) {
-                    box[d] = min2(box[d], p[e][d] - r);
-                    box[d + 3] = max2(box[d + 3], p[e][d] + r);
-                }
-        }
-        for (int d = 0; d < 3; ++d) {
-            s->bounds[d] = min2(s->bounds[d], box[d]);
-            s->bounds[d + 3] = max2(s->bounds[d + 3], box[d + 3]);
-        }
+    for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
+    for (int k = 0; k < 3; ++k) {
+        double p[2][3];
+        start_of(c, tri[k], p[0]);
+        end_of(c, tri[k], p[1]);
+        for (int e = 0; e < 2; ++e)
+            for (int d = 0; d < 3; ++d) {
+                box[d] = min2(box[d], p[e][d] - r);
+                box[d + 3] = max2(box[d + 3], p[e][d] + r);
+            }
     }
+}
+
+/* Box around the whole cloth over the step as it is now, grown by r. */
+static void cloth_bounds(const wc_cloth *c, double r, double box[6])
+{
+    for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        double p[2][3];
+        start_of(c, i, p[0]);
+        end_of(c, i, p[1]);
+        for (int e = 0; e < 2; ++e)
+            for (int d = 0; d < 3; ++d) {
+                box[d] = min2(box[d], p[e][d]);
+                box[d + 3] = max2(box[d + 3], p[e][d]);
+            }
+    }
+    for (int d = 0; d < 3; ++d) box[d] -= r, box[d + 3] += r;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -423,14 +431,20 @@ static int collider_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *co
                          const wc_near_list *near, double r, double mu, double dt)
 {
     int moved = 0;
-    if (!wc_boxes_overlap(col->bounds, s->bounds)) return 0;
+    if (!near) {
+        /* every element is visited: first see whether the cloth is near at all */
+        double bounds[6];
+        cloth_bounds(c, s->r_max, bounds);
+        if (!wc_boxes_overlap(col->bounds, bounds)) return 0;
+    }
     const wc_near_elements *tris = near ? &near->triangles : NULL, *edges = near ? &near->edges : NULL;
     int32_t count = tris ? tris->count : s->triangle_count;
     for (int32_t k = 0; k < count; ++k) {
         int32_t t = tris ? tris->element[k] : k;
-        const double *box = s->boxes + 6 * (size_t)t;
         const int32_t *tri = c->topology.triangles + 3 * (size_t)t;
         if (s->only_moved && !(s->moved[tri[0]] | s->moved[tri[1]] | s->moved[tri[2]])) continue;
+        double box[6];
+        triangle_box(c, tri, s->r_max, box);
         if (!wc_boxes_overlap(box, col->bounds)) continue;
         const int32_t *found;
         int32_t n = features_near(s, tris, k, &col->vertex_grid, box, &found);
@@ -504,7 +518,7 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
     for (int32_t k = 0; k < count; ++k)
         if (colliders[k]->is_mesh) r_max = max2(r_max, h + colliders[k]->thickness), any = 1;
     if (!any) return WC_OK;
-    box_triangles(s, c, r_max);
+    s->r_max = r_max;
     int moved = 1;
     for (int pass = 0; pass < MAX_PASSES && moved; ++pass) {
         s->only_moved = pass > 0;
