@@ -30,6 +30,9 @@ MATERIAL_FIELDS = ("density", "stretch", "bend", "damping", "air_drag", "thickne
 
 _applying_preset = False
 
+# Blender 4.5 warns about "//" paths unless the property says it takes them.
+_PATH_OPTIONS = ({"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set())
+
 
 def _apply_preset(self, _context):
     global _applying_preset
@@ -44,6 +47,9 @@ def _apply_preset(self, _context):
         self.drying = 0.0
     finally:
         _applying_preset = False
+
+# Blender 4.5 warns about "//" paths unless the property says it takes them.
+_PATH_OPTIONS = ({"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set())
 
 
 def _material_edited(self, _context):
@@ -137,6 +143,7 @@ class WetClothSettings(bpy.types.PropertyGroup):
                           description="Steps per frame when not automatic")
     cache_dir: StringProperty(
         name="Cache Folder", default="//wetcloth_cache/", subtype="DIR_PATH",
+        options=_PATH_OPTIONS,
         description="Folder for the PC2 point cache (// means next to the .blend file)")
 
     # What the last bake wrote (read only in the UI).

@@ -6,6 +6,9 @@
 set -euo pipefail
 
 packages=(cmake ninja-build gcc libc6-dev libccd-dev pkg-config python3-venv)
+# The X11/GL client libraries bpy (Blender as a Python module, for the Blender
+# add-on's tests) links against, even headless.
+packages+=(libx11-6 libxrender1 libxfixes3 libxi6 libxkbcommon0 libsm6 libgl1 libxext6 libxt6)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -4,8 +4,9 @@
 #   build-asan/  Debug, AddressSanitizer + UndefinedBehaviorSanitizer, -DWC_WERROR=ON
 # and `ctest --output-on-failure` in each: the C tests, and the Python tests
 # (binding, scene runner, command line, `pip install .`) with the
-# interpreter of .venv/ (made by scripts/venv.sh). Exits non-zero if either
-# fails.
+# interpreter of .venv/ (made by scripts/venv.sh), and in build/ the Blender
+# add-on's tests inside bpy 4.5 from .venv-blender/ (made by
+# scripts/venv-blender.sh). Exits non-zero if either fails.
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -13,9 +14,12 @@ cd "$root"
 
 scripts/install-deps.sh
 scripts/venv.sh
+scripts/venv-blender.sh
 
-# The Python tests must run here: a missing package is an error, not a skip.
-python_args=(-DWC_PYTHON="$root/.venv/bin/python" -DWC_PYTHON_REQUIRED=ON)
+# The Python and Blender tests must run here: a missing package is an error,
+# not a skip.
+python_args=(-DWC_PYTHON="$root/.venv/bin/python" -DWC_PYTHON_REQUIRED=ON
+             -DWC_BLENDER_PYTHON="$root/.venv-blender/bin/python" -DWC_BLENDER_REQUIRED=ON)
 
 jobs=$(nproc 2>/dev/null || echo 2)
 

@@ -1,0 +1,400 @@
+"""The Blender add-on, headless in bpy 4.5 from PyPI: built as a zip by
+tools/build_blender_addon.py, installed and enabled through Blender's
+extension system, then baked on small scenes (see conftest.py)."""
+
+import os
+import struct
+import sys
+import zipfile
+
+import bpy
+import numpy as np
+import pytest
+
+from conftest import MODULE
+
+SPHERE_R = 0.3
+
+
+# ---------------------------------------------------------------------------
+# helpers
+
+
+def read_pc2(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    magic, version, n, start, sampling, frames = struct.unpack("<12siiffi", data[:32])
+    assert magic == b"POINTCACHE2\0" and version == 1
+    body = np.frombuffer(data[32:], dtype="<f4")
+    assert body.size == frames * n * 3
+    return {"n": n, "start": start, "sampling": sampling, "frames": frames}, \
+        body.reshape(frames, n, 3)
+
+
+def positions(mesh):
+    co = np.empty(3 * len(mesh.vertices), dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def evaluated_positions(ob):
+    dg = bpy.context.evaluated_depsgraph_get()
+    ev = ob.evaluated_get(dg)
+    m = ev.to_mesh()
+    try:
+        return positions(m).copy()
+    finally:
+        ev.to_mesh_clear()
+
+
+def add_sphere(location=(0.0, 0.0, 0.0), collision=True):
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8, radius=SPHERE_R,
+                                         location=location)
+    ob = bpy.context.object
+    ob.name = "Sphere"
+    if collision:
+        ob.modifiers.new("Collision", "COLLISION")
+    return ob
+
+
+def add_cloth(cache_dir, z=0.6, cuts=15, name="Cloth"):
+    """A 1 m plane of (cuts+2)^2 vertices at height z, Wet Cloth enabled."""
+    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.0, 0.0, z))
+    ob = bpy.context.object
+    ob.name = name
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.subdivide(number_cuts=cuts)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    ob.wet_cloth.enabled = True
+    ob.wet_cloth.cache_dir = cache_dir
+    return ob
+
+
+def bake(ob, **kw):
+    with bpy.context.temp_override(active_object=ob, object=ob, selected_objects=[ob]):
+        return bpy.ops.wetcloth.bake(**kw)
+
+
+def bake_error(ob, **kw):
+    with pytest.raises(RuntimeError) as info:
+        bake(ob, **kw)
+    text = str(info.value)
+    assert "Traceback" not in text
+    return text
+
+
+def cache_path(ob):
+    return bpy.path.abspath(ob.wet_cloth.cache_file)
+
+
+def world_matrix(ob):
+    return np.array(ob.matrix_world, dtype=np.float64)
+
+
+def convex_planes(ob):
+    """(normals, offsets) of the faces of a convex mesh, in world space:
+    a point p is inside when normals @ p < offsets for every face."""
+    m = world_matrix(ob)
+    v = positions(ob.data).astype(np.float64) @ m[:3, :3].T + m[:3, 3]
+    normals, offsets = [], []
+    for poly in ob.data.polygons:
+        p = v[list(poly.vertices)]
+        n = np.cross(p[1] - p[0], p[2] - p[0])
+        n /= np.linalg.norm(n)
+        normals.append(n)
+        offsets.append(n @ p[0])
+    return np.array(normals), np.array(offsets)
+
+
+# ---------------------------------------------------------------------------
+# the zip and its installation
+
+
+def test_zip_contents(addon_zip):
+    with zipfile.ZipFile(addon_zip) as z:
+        names = set(z.namelist())
+        manifest = z.read("blender_manifest.toml").decode()
+    assert os.path.basename(addon_zip) == "wetcloth-0.1.0-linux_x64.zip"
+    for name in ("__init__.py", "bake.py", "ops.py", "props.py", "ui.py",
+                 "wetcloth/__init__.py", "wetcloth/_core.py", "wetcloth/_ffi.py",
+                 "wetcloth/meshio.py", "wetcloth/libwetcloth.so"):
+        assert name in names, name
+    wheels = [n for n in names if n.startswith("wheels/")]
+    assert len(wheels) == 1 and "cffi-" in wheels[0] and "cp311" in wheels[0]
+    assert 'id = "wetcloth"' in manifest
+    assert 'blender_version_min = "4.2.0"' in manifest
+    assert 'platforms = ["linux-x64"]' in manifest
+    assert 'wheels = ["./%s"]' % wheels[0] in manifest
+
+
+def test_installed_through_extensions(installed):
+    assert installed.__name__ == MODULE
+    # cffi comes from the bundled wheel: bpy from PyPI has none of its own.
+    import _cffi_backend
+    assert "extensions" in _cffi_backend.__file__
+    # the library inside the add-on is the one loaded
+    from bl_ext.user_default.wetcloth import bake as bake_mod
+    wc = bake_mod.load_wetcloth()
+    assert wc.__name__ == MODULE + ".wetcloth"
+    assert wc.library_path.startswith(os.path.dirname(installed.__file__))
+    assert wc.__version__ == "0.1.0"
+    assert hasattr(bpy.types.Object, "wet_cloth")
+    assert bpy.types.PHYSICS_PT_wet_cloth.bl_context == "physics"
+    assert bpy.types.PHYSICS_PT_wet_cloth.bl_label == "Wet Cloth"
+    assert hasattr(bpy.ops.wetcloth, "bake") and hasattr(bpy.ops.wetcloth, "free_bake")
+
+
+def test_presets(empty_scene, cache_dir):
+    s = add_cloth(cache_dir).wet_cloth
+    assert s.preset == "COTTON" and s.density == pytest.approx(0.15)
+    s.preset = "DENIM"
+    assert s.density == pytest.approx(0.40) and s.stretch == pytest.approx(3000.0)
+    s.preset = "SILK"
+    assert s.density == pytest.approx(0.06)
+    s.adhesion = 55.0  # a hand edit makes the material custom, keeping the values
+    assert s.preset == "CUSTOM" and s.density == pytest.approx(0.06)
+    s.preset = "TOWEL"
+    assert s.density == pytest.approx(0.45) and s.preset == "TOWEL"
+
+
+# ---------------------------------------------------------------------------
+# the drape
+
+
+@pytest.fixture
+def draped(empty_scene, cache_dir):
+    sphere = add_sphere()
+    cloth = add_cloth(cache_dir)
+    original = positions(cloth.data).copy()
+    assert bake(cloth) == {"FINISHED"}
+    return cloth, sphere, original
+
+
+def test_drape_cache(draped):
+    cloth, sphere, original = draped
+    header, frames = read_pc2(cache_path(cloth))
+    n = len(cloth.data.vertices)
+    assert header["frames"] == 24 and header["n"] == n == 17 * 17
+    assert header["start"] == 1.0
+    # object-local coordinates: frame 1 is the mesh as it is
+    np.testing.assert_allclose(frames[0], original, atol=1e-6)
+    world = frames.astype(np.float64) + np.array(cloth.location)
+    # it fell ...
+    assert world[-1, :, 2].mean() < 0.6 - 0.15
+    # ... onto the sphere: its middle vertex rests on top
+    mid = np.argmin(np.linalg.norm(original[:, :2], axis=1))
+    assert SPHERE_R < world[-1, mid, 2] < SPHERE_R + 0.04
+    # ... came to rest: over the last frame the part on the sphere stays
+    # put and the cloth as a whole moves little (the free corners still sway)
+    step = np.linalg.norm(world[-1] - world[-2], axis=1)
+    assert step[mid] < 0.0005 and step.mean() < 0.002, (step[mid], step.mean())
+    # ... and no vertex ever went inside the sphere
+    normals, offsets = convex_planes(sphere)
+    inside = np.all(world @ normals.T < offsets[None, None, :], axis=2)
+    assert not inside.any(), np.argwhere(inside)[:5]
+
+
+def test_mesh_cache_plays_the_cache(draped):
+    cloth, _sphere, original = draped
+    mod = cloth.modifiers["Wet Cloth Cache"]
+    assert mod.type == "MESH_CACHE" and mod.cache_format == "PC2"
+    assert mod.frame_start == bpy.context.scene.frame_start
+    _header, frames = read_pc2(cache_path(cloth))
+    for frame in (1, 12, 24):
+        bpy.context.scene.frame_set(frame)
+        np.testing.assert_allclose(evaluated_positions(cloth), frames[frame - 1], atol=1e-6)
+    # the original mesh is untouched
+    np.testing.assert_array_equal(positions(cloth.data), original)
+
+
+def test_wetness_attributes(draped):
+    cloth, _sphere, _original = draped
+    attrs = cloth.data.attributes
+    wet = np.empty(len(cloth.data.vertices), np.float32)
+    attrs["wet_cloth_wetness"].data.foreach_get("value", wet)
+    np.testing.assert_allclose(wet, 1.0)
+    stuck = np.empty(len(cloth.data.vertices), np.float32)
+    attrs["wet_cloth_stuck"].data.foreach_get("value", stuck)
+    assert set(np.unique(stuck)) <= {0.0, 1.0}
+    assert stuck.sum() > 10  # the wet cloth sticks where it lies on the sphere
+
+
+def test_free_bake(draped):
+    cloth, _sphere, original = draped
+    path = cache_path(cloth)
+    assert os.path.isfile(path)
+    with bpy.context.temp_override(active_object=cloth, object=cloth):
+        assert bpy.ops.wetcloth.free_bake() == {"FINISHED"}
+    assert "Wet Cloth Cache" not in cloth.modifiers
+    assert not os.path.exists(path)
+    assert os.listdir(os.path.dirname(path)) == []
+    assert "wet_cloth_wetness" not in cloth.data.attributes
+    assert "wet_cloth_stuck" not in cloth.data.attributes
+    assert cloth.wet_cloth.cache_file == ""
+    np.testing.assert_array_equal(evaluated_positions(cloth), original)
+    # freeing again says there is nothing to free
+    assert bpy.ops.wetcloth.free_bake(object=cloth.name) == {"FINISHED"}
+
+
+def test_rebake_replaces(draped):
+    cloth, _sphere, _original = draped
+    first = cache_path(cloth)
+    cloth.wet_cloth.wetness = 0.0
+    assert bake(cloth) == {"FINISHED"}
+    assert cache_path(cloth) == first
+    assert len([m for m in cloth.modifiers if m.type == "MESH_CACHE"]) == 1
+    assert sorted(os.listdir(os.path.dirname(first))) == ["Cloth.pc2"]
+    stuck = np.empty(len(cloth.data.vertices), np.float32)
+    cloth.data.attributes["wet_cloth_stuck"].data.foreach_get("value", stuck)
+    assert stuck.sum() == 0  # dry cloth never sticks
+
+
+# ---------------------------------------------------------------------------
+# bad setups and failed bakes
+
+
+def test_bad_setups(empty_scene, cache_dir):
+    bpy.ops.object.empty_add()
+    empty = bpy.context.object
+    assert "is not a mesh" in bake_error(empty)
+
+    mesh = bpy.data.meshes.new("Points")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [])
+    points = bpy.data.objects.new("Points", mesh)
+    empty_scene.collection.objects.link(points)
+    points.wet_cloth.enabled = True
+    assert "has no faces" in bake_error(points)
+
+    cloth = add_cloth(cache_dir)
+    cloth.wet_cloth.enabled = False
+    assert "not enabled" in bake_error(cloth)
+    cloth.wet_cloth.enabled = True
+
+    assert "nothing to collide with" in bake_error(cloth)
+    sphere = add_sphere(collision=False)
+    assert "nothing to collide with" in bake_error(cloth)
+    sphere.modifiers.new("Collision", "COLLISION")
+    coll = bpy.data.collections.new("Colliders")
+    empty_scene.collection.children.link(coll)
+    cloth.wet_cloth.collision_collection = coll
+    assert "in the collection 'Colliders'" in bake_error(cloth)
+    cloth.wet_cloth.collision_collection = None
+
+    blocker = os.path.join(cache_dir, "a-file")
+    open(blocker, "w").close()
+    cloth.wet_cloth.cache_dir = os.path.join(blocker, "sub") + os.sep
+    assert "cannot create the cache folder" in bake_error(cloth)
+    cloth.wet_cloth.cache_dir = "//cache/"
+    assert "not saved yet" in bake_error(cloth)
+    cloth.wet_cloth.cache_dir = cache_dir
+
+    cloth.wet_cloth.use_scene_range = False
+    cloth.wet_cloth.frame_start, cloth.wet_cloth.frame_end = 10, 10
+    assert "frame range" in bake_error(cloth)
+    cloth.wet_cloth.use_scene_range = True
+
+    cloth.wet_cloth.pin_group = "nope"
+    assert "no vertex group 'nope'" in bake_error(cloth)
+    cloth.wet_cloth.pin_group = ""
+
+    assert "no object named" in bake_error(cloth, object="missing")
+    # none of these left anything behind
+    assert sorted(os.listdir(cache_dir)) == ["a-file"]
+    assert "Wet Cloth Cache" not in cloth.modifiers
+    assert "wet_cloth_wetness" not in cloth.data.attributes
+
+
+def test_failed_bake_keeps_previous(draped):
+    cloth, sphere, original = draped
+    path = cache_path(cloth)
+    with open(path, "rb") as f:
+        before = f.read()
+    wet_before = np.empty(len(cloth.data.vertices), np.float32)
+    cloth.data.attributes["wet_cloth_wetness"].data.foreach_get("value", wet_before)
+    scene = bpy.context.scene
+    scene.frame_set(7)
+    # A collider whose vertex count changes over time fails the bake midway.
+    build = sphere.modifiers.new("Build", "BUILD")
+    build.use_reverse = True  # whole at first, then loses faces
+    build.frame_start, build.frame_duration = 5, 20
+    sphere.modifiers.move(len(sphere.modifiers) - 1, 0)
+    cloth.wet_cloth.wetness = 0.2
+    text = bake_error(cloth)
+    assert "collider Sphere changed its vertex count" in text
+    with open(path, "rb") as f:
+        assert f.read() == before
+    assert os.listdir(os.path.dirname(path)) == ["Cloth.pc2"]  # no temporary file left
+    mod = cloth.modifiers["Wet Cloth Cache"]
+    assert mod.show_viewport and bpy.path.abspath(mod.filepath) == path
+    wet = np.empty(len(cloth.data.vertices), np.float32)
+    cloth.data.attributes["wet_cloth_wetness"].data.foreach_get("value", wet)
+    np.testing.assert_array_equal(wet, wet_before)
+    assert scene.frame_current == 7
+    np.testing.assert_array_equal(positions(cloth.data), original)
+
+
+def test_invoke_runs_synchronously_headless(empty_scene, cache_dir):
+    add_sphere()
+    cloth = add_cloth(cache_dir, cuts=4)
+    with bpy.context.temp_override(active_object=cloth, object=cloth):
+        assert bpy.ops.wetcloth.bake("INVOKE_DEFAULT") == {"FINISHED"}
+    assert os.path.isfile(cache_path(cloth))
+
+
+# ---------------------------------------------------------------------------
+# animation
+
+
+def test_animated_collider_moves_the_cloth(empty_scene, cache_dir):
+    """No gravity: the cloth only moves because the sphere rises through
+    where it hangs."""
+    empty_scene.use_gravity = False
+    sphere = add_sphere(location=(0.0, 0.0, 0.0))
+    sphere.keyframe_insert("location", frame=1)
+    sphere.location.z = 0.8
+    sphere.keyframe_insert("location", frame=24)
+    cloth = add_cloth(cache_dir, z=0.45)
+    cloth.wet_cloth.wetness = 0.0
+    assert bake(cloth) == {"FINISHED"}
+    _header, frames = read_pc2(cache_path(cloth))
+    z = frames[:, :, 2] + 0.45
+    assert np.abs(z[:4] - 0.45).max() < 1e-3  # at rest until the sphere arrives
+    assert z[-1].max() > 0.8 + SPHERE_R - 0.05  # carried up on top of it
+    # never inside the moving sphere
+    for f in range(24):
+        empty_scene.frame_set(f + 1)
+        normals, offsets = convex_planes(sphere)
+        world = frames[f].astype(np.float64) + np.array(cloth.location)
+        assert not np.all(world @ normals.T < offsets, axis=1).any(), f + 1
+
+
+def test_pins_follow_the_object_and_range(empty_scene, cache_dir):
+    """Pinned corners follow the object's animated transform; the bake's own
+    frame range sets the Mesh Cache modifier's start."""
+    add_sphere(location=(0.0, 0.0, -1.0))
+    cloth = add_cloth(cache_dir, cuts=6)
+    v = positions(cloth.data)
+    corners = [i for i in range(len(v)) if abs(v[i, 0]) > 0.49 and v[i, 1] > 0.49]
+    assert len(corners) == 2
+    group = cloth.vertex_groups.new(name="pins")
+    group.add(corners, 1.0, "REPLACE")
+    cloth.wet_cloth.pin_group = "pins"
+    cloth.keyframe_insert("location", frame=5)
+    cloth.location.x += 0.5
+    cloth.keyframe_insert("location", frame=20)
+    s = cloth.wet_cloth
+    s.use_scene_range = False
+    s.frame_start, s.frame_end = 5, 20
+    assert bake(cloth) == {"FINISHED"}
+    header, frames = read_pc2(cache_path(cloth))
+    assert header["frames"] == 16 and header["start"] == 5.0
+    # local coordinates of the pins never change; the free corner falls
+    np.testing.assert_allclose(frames[:, corners], np.broadcast_to(v[corners], (16, 2, 3)),
+                               atol=1e-5)
+    free = [i for i in range(len(v)) if abs(v[i, 0]) > 0.49 and v[i, 1] < -0.49][0]
+    assert frames[-1, free, 2] < v[free, 2] - 0.3
+    mod = cloth.modifiers["Wet Cloth Cache"]
+    assert mod.frame_start == 5.0
+    for frame in (5, 12, 20):
+        empty_scene.frame_set(frame)
+        np.testing.assert_allclose(evaluated_positions(cloth), frames[frame - 5], atol=1e-6)
