@@ -398,3 +398,39 @@ def test_pins_follow_the_object_and_range(empty_scene, cache_dir):
     for frame in (5, 12, 20):
         empty_scene.frame_set(frame)
         np.testing.assert_allclose(evaluated_positions(cloth), frames[frame - 5], atol=1e-6)
+
+
+def test_wetness_group_and_deforming_collider(empty_scene, cache_dir):
+    """A wetness vertex group scales the wetness per vertex; a collider
+    deformed by a modifier (not moved) pushes the cloth: a plate that an
+    animated Displace modifier lifts along its normals."""
+    empty_scene.use_gravity = False
+    bpy.ops.mesh.primitive_plane_add(size=1.6, location=(0.0, 0.0, 0.0))
+    plate = bpy.context.object
+    plate.name = "Plate"
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.subdivide(number_cuts=10)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    lift = plate.modifiers.new("Lift", "DISPLACE")  # no texture: a uniform offset
+    lift.mid_level, lift.strength = 0.0, 0.0
+    lift.keyframe_insert("strength", frame=1)
+    lift.strength = 0.4
+    lift.keyframe_insert("strength", frame=24)
+    plate.modifiers.new("Collision", "COLLISION")
+    cloth = add_cloth(cache_dir, z=0.1, cuts=8)
+    v = positions(cloth.data)
+    half = [i for i in range(len(v)) if v[i, 0] > 0.0]
+    group = cloth.vertex_groups.new(name="wet")
+    group.add(half, 0.5, "REPLACE")
+    cloth.wet_cloth.wetness = 0.8
+    cloth.wet_cloth.wetness_group = "wet"
+    assert bake(cloth) == {"FINISHED"}
+    wet = np.empty(len(v), np.float32)
+    cloth.data.attributes["wet_cloth_wetness"].data.foreach_get("value", wet)
+    expected = np.zeros(len(v))
+    expected[half] = 0.4
+    np.testing.assert_allclose(wet, expected, atol=1e-6)
+    _header, frames = read_pc2(cache_path(cloth))
+    z = frames[:, :, 2] + 0.1
+    assert np.abs(z[:3] - 0.1).max() < 1e-3  # untouched until the plate arrives
+    assert z[-1].min() > 0.4  # then carried up by the plate, all of it
