@@ -187,6 +187,10 @@ struct wc_self_state {
     /// Whether the candidates were built (for the thickness built_h): a step
     /// whose motion stays inside the boxes and keeps the culling reuses them.
     int built;
+    /// Whether triangle_normals, patch_axis and patch_cos describe the
+    /// current motion (still_valid brought them up to date and nothing has
+    /// moved since), so a broadphase right after need not make them again.
+    int cones_current;
     double built_h;
 };
 
@@ -975,7 +979,7 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
 #pragma omp parallel for schedule(static) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
     for (int32_t t = 0; t < nt; ++t) {
         const int32_t *tri = s->triangles + 3 * (size_t)t;
-        triangle_normal_motion(c, tri, s->triangle_normals + 9 * (size_t)t);
+        if (!s->cones_current) triangle_normal_motion(c, tri, s->triangle_normals + 9 * (size_t)t);
         double *box = s->triangle_boxes + 6 * (size_t)t;
         memcpy(box, s->particle_boxes + 6 * (size_t)tri[0], 6 * sizeof *box);
         union_box(box, s->particle_boxes + 6 * (size_t)tri[1]);
@@ -992,7 +996,7 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
             union_box(box, s->particle_boxes + 6 * (size_t)pp->items[k]);
         double *grown = s->patch_grown + 6 * (size_t)p;
         for (int k = 0; k < 3; ++k) grown[k] = box[k] - h, grown[k + 3] = box[k + 3] + h;
-        patch_cone(s, p);
+        if (!s->cones_current) patch_cone(s, p);
         for (int32_t k = pe->start[p]; k < pe->start[p + 1]; ++k) {
             int32_t e = pe->items[k];
             double *eb = s->edge_boxes + 6 * (size_t)e;
@@ -1432,8 +1436,9 @@ static int respond_all(wc_cloth *c, wc_self_state *s, const self_ctx *ctx, int p
  * particles moved (those marked dirty): each inside its box, and every
  * culling decision that involves a patch holding one of them still true
  * for the new motion. */
-static int still_valid(wc_self_state *s, const wc_cloth *c)
+static int still_valid(wc_self_state *s, const wc_cloth *c, int threads)
 {
+    s->cones_current = 0;
     for (int32_t i = 0; i < s->particle_count; ++i) {
         if (!s->dirty[i]) continue;
         const double *b = s->particle_boxes + 6 * (size_t)i;
@@ -1443,6 +1448,9 @@ static int still_valid(wc_self_state *s, const wc_cloth *c)
     }
     const csr *pp = &s->patch_particles, *adj = &s->patch_adjacent;
     int any = 0;
+    /* Each patch writes only its own triangles' normals and its own cone. */
+#pragma omp parallel for schedule(static) num_threads(threads) if (s->triangle_count >= WC_PARALLEL_MIN) \
+    reduction(| : any)
     for (int32_t p = 0; p < s->patch_count; ++p) {
         uint8_t touched = 0;
         for (int32_t k = pp->start[p]; k < pp->start[p + 1] && !touched; ++k) touched = s->dirty[pp->items[k]];
@@ -1455,6 +1463,9 @@ static int still_valid(wc_self_state *s, const wc_cloth *c)
         }
         patch_cone(s, p);
     }
+    /* Untouched patches' particles have not moved since their cones were
+     * made, so now every cone is current. */
+    s->cones_current = 1;
     if (!any) return 1;
     for (int32_t p = 0; p < s->patch_count; ++p) {
         if (!s->patch_touched[p]) continue;
@@ -1515,7 +1526,7 @@ static wc_status failsafe(wc_cloth *c, wc_self_state *s, self_ctx *ctx, double g
         }
         if (!newly) break;
         total += newly;
-        if (!still_valid(s, c)) {
+        if (!still_valid(s, c, threads)) {
             s->built = 0;
             if (broadphase(s, c, ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
             s->built = 1;
@@ -1573,10 +1584,11 @@ wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *st
      * motion stays inside its box and the culled patches keep their cones
      * (still_valid with every particle marked): cloth at rest or moving
      * slowly skips the broadphase. */
+    s->cones_current = 0; /* the cloth has moved since the last step */
     int rebuild = !(s->built && s->built_h == ctx.h);
     if (!rebuild) {
         memset(s->dirty, 1, (size_t)s->particle_count);
-        rebuild = !still_valid(s, c);
+        rebuild = !still_valid(s, c, threads);
         if (!rebuild) {
             if (s->vf_count) memset(s->vf_status, 0, (size_t)s->vf_count);
             if (s->ee_count) memset(s->ee_status, 0, (size_t)s->ee_count);
@@ -1592,7 +1604,7 @@ wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *st
         int last = pass >= SELF_PASSES;
         evaluate(s, &ctx, last, threads);
         if (last || !respond_all(c, s, &ctx, pass, &marked)) break;
-        rebuild = !still_valid(s, c);
+        rebuild = !still_valid(s, c, threads);
     }
     if (failsafe(c, s, &ctx, g, threads, &reverted)) return WC_ERROR_OUT_OF_MEMORY;
     if (c->wet_forces) note_adhesive(c, s, &ctx);
