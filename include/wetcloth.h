@@ -581,6 +581,30 @@ typedef struct wc_intersection_counts {
 WC_API wc_status wc_world_count_intersections(const wc_world *world,
                                               wc_intersection_counts *out_counts);
 
+/* ------------------------------------------------------------------------ */
+/* Memory                                                                    */
+/* ------------------------------------------------------------------------ */
+
+/// Allocation hook: returns `size` bytes (size >= 1) aligned for any type, as
+/// malloc does, or NULL when it cannot. The library zeroes the memory itself.
+/// `user` is the pointer given to wc_set_allocator().
+typedef void *wc_alloc_fcn(size_t size, void *user);
+/// Frees what the allocation hook returned (never called with NULL).
+typedef void wc_free_fcn(void *memory, void *user);
+
+/// Routes every heap allocation of the library (worlds, cloths, colliders,
+/// the buffers a step grows) through alloc_fcn and free_fcn, in the manner
+/// of Box2D's b2SetAllocator. Both NULL (or either NULL) restores malloc and
+/// free. Process-wide: call it while no world exists, since a world's
+/// memory must be freed by the hook that allocated it. The hooks may be
+/// called from several OpenMP threads at once inside a step unless
+/// wc_world_def.thread_count is 1. When the hook returns NULL, the call
+/// that needed the memory returns WC_ERROR_OUT_OF_MEMORY with a message,
+/// frees what it had allocated and leaves the world as it was (a step keeps
+/// its last good state). libccd's and OpenMP's own small internal
+/// allocations do not pass through the hook.
+WC_API void wc_set_allocator(wc_alloc_fcn *alloc_fcn, wc_free_fcn *free_fcn, void *user);
+
 #ifdef __cplusplus
 }
 #endif
