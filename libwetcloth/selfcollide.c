@@ -1016,7 +1016,7 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
     if (!(cell > 0.0) || !isfinite(cell)) cell = 1.0;
     if (wc_grid_build(&s->patch_grid, s->patch_grown, np, cell)) return WC_ERROR_OUT_OF_MEMORY;
 
-    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
+    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0, s->slices[k].failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
     for (int k = 0; k < SLICES; ++k)
         patch_pairs_slice(s, &s->slices[k], slice_begin(np, k), slice_begin(np, k + 1));
@@ -1051,7 +1051,7 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
 
     /* Element pairs of the opened patch pairs: vertex-face both ways, then
      * edge-edge. */
-    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
+    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0, s->slices[k].failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (open >= 64)
     for (int k = 0; k < SLICES; ++k)
         for (int64_t m = slice_begin(open, k); m < slice_begin(open, k + 1); ++m) {
@@ -1070,7 +1070,7 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
     for (int k = 0, at = 0; k < SLICES; at += (int)s->slices[k].count, ++k)
         if (s->slices[k].count)
             memcpy(s->vf_h + at, s->slices[k].values, (size_t)s->slices[k].count * sizeof *s->vf_h);
-    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0;
+    for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0, s->slices[k].failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (open >= 64)
     for (int k = 0; k < SLICES; ++k)
         for (int64_t m = slice_begin(open, k); m < slice_begin(open, k + 1); ++m)
