@@ -79,7 +79,20 @@ typedef struct wc_world wc_world;
 typedef enum wc_integrator {
     /// Position Verlet, x(t+dt) = 2x(t) - x(t-dt) + a dt^2 (thesis eq. 2.4).
     /// Explicit: stable for dt below wc_world_stable_dt().
-    WC_INTEGRATOR_VERLET = 0
+    WC_INTEGRATOR_VERLET = 0,
+    /// Strain-limited stretch: Verlet for every force but the stretch links,
+    /// which are tension-only constraints solved by compliant projection
+    /// (XPBD, one Gauss-Seidel iteration per step, as in Macklin et al.
+    /// 2019, "Small Steps in Physics Simulation"; the steps are the small
+    /// substeps). Stretch stiffness no longer limits the step (any value,
+    /// up to inextensible); bending and drag still do.
+    WC_INTEGRATOR_XPBD = 1,
+    /// Semi-implicit backward Euler (Choi & Ko 2002; Baraff & Witkin 1998):
+    /// the stretch links' linearised Jacobian and the bend links' axial
+    /// stiffness (their indefinite transverse term dropped, as Choi & Ko do)
+    /// in one linear system per step, solved by block-Jacobi preconditioned
+    /// conjugate gradients. Free fall lags the exact parabola by g t dt / 2.
+    WC_INTEGRATOR_IMPLICIT = 2
 } wc_integrator;
 
 /// Description of a world. Start from wc_world_def_default().
@@ -128,10 +141,12 @@ WC_API wc_status wc_world_step(wc_world *world, double dt);
 /// the last good substep (see wc_world_time()).
 WC_API wc_status wc_world_advance(wc_world *world, double frame_dt, int32_t substeps);
 
-/// Largest step, s, at which the integrator is estimated to stay stable for
-/// every cloth in the world (an upper bound on the highest link frequency,
-/// from Gershgorin's theorem, so it errs on the safe side). +inf when there
-/// is no cloth.
+/// Largest step, s, at which the world's integrator is estimated to stay
+/// stable for every cloth in the world (an upper bound on the highest
+/// frequency of what the integrator treats explicitly, from Gershgorin's
+/// theorem, so it errs on the safe side): every link for Verlet; bend links
+/// and drag for XPBD; the dropped transverse bending term for the implicit
+/// integrator. +inf when there is no cloth.
 WC_API double wc_world_stable_dt(const wc_world *world);
 
 /// Substeps the last wc_world_advance() used (0 before any).

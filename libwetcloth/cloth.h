@@ -61,8 +61,15 @@ typedef struct wc_cloth {
     int32_t *pin_slot;
     wc_pins pins;
 
-    /// Stable step estimate, s (see wc_world_stable_dt).
+    /// The world's integrator (set when the cloth joins a world).
+    wc_integrator integrator;
+    /// Stable step estimate for that integrator, s (see wc_world_stable_dt
+    /// and estimate_stable_dt in cloth.c).
     double stable_dt;
+    /// Buffers of the large-step integrators (xpbd.c, implicit.c), made at
+    /// their first step: NULL in a Verlet world, which pays nothing for them.
+    struct wc_xpbd_state *xpbd;
+    struct wc_implicit_state *implicit;
 
     /* Collisions. */
     /// wc_contact_kind of each particle in the last step.
@@ -122,6 +129,10 @@ void wc_cloth_commit(wc_cloth *cloth, double dt, int with_overrides);
 /// Derives masses, link constants and the stable step from the material and
 /// the current wetness (see wc_material). Call after wetness changes.
 void wc_cloth_apply_material(wc_cloth *cloth);
+
+/// Sets the integrator that will step the cloth, and the stable step
+/// estimate with it.
+void wc_cloth_set_integrator(wc_cloth *cloth, wc_integrator integrator);
 
 /// Velocity of particle i, m/s (see wc_cloth_get_velocities).
 void wc_cloth_velocity(const wc_cloth *cloth, int32_t i, double v[3]);

@@ -48,6 +48,7 @@ static wc_status append_cloth(wc_world *w, wc_cloth *c, int32_t *out_cloth)
         w->cloths = grown;
         w->cloth_capacity = capacity;
     }
+    wc_cloth_set_integrator(c, w->def.integrator);
     w->cloths[w->cloth_count] = c;
     *out_cloth = w->cloth_count++;
     return WC_OK;

@@ -107,7 +107,9 @@ static void gather_particle_forces(wc_cloth *c, const double g[3], int threads)
 void wc_forces_compute(wc_cloth *c, const double gravity[3], int threads)
 {
     if (c->vx) compute_velocities(c, threads);
-    stretch_link_forces(c, threads);
+    /* Under XPBD the stretch links are constraints (xpbd.c), not forces:
+     * their entries in link_fx stay at zero from the allocation. */
+    if (c->integrator != WC_INTEGRATOR_XPBD) stretch_link_forces(c, threads);
     bend_link_forces(c, threads);
     gather_particle_forces(c, gravity, threads);
 }

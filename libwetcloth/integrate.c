@@ -4,7 +4,7 @@
 
 #include "parallel.h"
 
-static void pinned_position(const wc_cloth *c, int32_t slot, double fraction, double out[3])
+void wc_pinned_position(const wc_cloth *c, int32_t slot, double fraction, double out[3])
 {
     const double *from = c->pins.from + 3 * (size_t)slot, *to = c->pins.to + 3 * (size_t)slot;
     for (int k = 0; k < 3; ++k) out[k] = fraction == 1.0 ? to[k] : from[k] + (to[k] - from[k]) * fraction;
@@ -29,7 +29,7 @@ int32_t wc_integrate_verlet(wc_cloth *c, double dt, double pin_fraction, int thr
     for (int32_t i = 0; i < n; ++i) {
         double p[3];
         if (c->pin_slot[i] >= 0) {
-            pinned_position(c, c->pin_slot[i], pin_fraction, p);
+            wc_pinned_position(c, c->pin_slot[i], pin_fraction, p);
         } else {
             double s = c->inv_mass[i] * acc_scale;
             double mx = first ? c->px[i] : c->x[i] - c->px[i];
@@ -45,5 +45,12 @@ int32_t wc_integrate_verlet(wc_cloth *c, double dt, double pin_fraction, int thr
     if (!bad) return -1;
     for (int32_t i = 0; i < n; ++i)
         if (!(isfinite(c->nx[i]) && isfinite(c->ny[i]) && isfinite(c->nz[i]))) return i;
+    return -1;
+}
+
+int32_t wc_first_non_finite_xyz(const double *x, const double *y, const double *z, int32_t n)
+{
+    for (int32_t i = 0; i < n; ++i)
+        if (!(isfinite(x[i]) && isfinite(y[i]) && isfinite(z[i]))) return i;
     return -1;
 }

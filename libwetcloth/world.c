@@ -7,11 +7,13 @@
 #include "collide.h"
 #include "collide_features.h"
 #include "forces.h"
+#include "implicit.h"
 #include "integrate.h"
 #include "parallel.h"
 #include "selfcollide.h"
 #include "status.h"
 #include "wetness.h"
+#include "xpbd.h"
 
 int32_t wc_version(void) { return WC_VERSION; }
 
@@ -44,9 +46,11 @@ static wc_status validate_world_def(const wc_world_def *d, wc_message *msg)
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.thread_count must be in [0, 1024] (0 = OpenMP default) but is %d",
                        (int)d->thread_count);
-    if (d->integrator != WC_INTEGRATOR_VERLET)
+    if (d->integrator != WC_INTEGRATOR_VERLET && d->integrator != WC_INTEGRATOR_XPBD &&
+        d->integrator != WC_INTEGRATOR_IMPLICIT)
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
-                       "world_def.integrator must be WC_INTEGRATOR_VERLET (0) but is %d",
+                       "world_def.integrator must be WC_INTEGRATOR_VERLET (0), "
+                       "WC_INTEGRATOR_XPBD (1) or WC_INTEGRATOR_IMPLICIT (2) but is %d",
                        (int)d->integrator);
     if (!(d->substep_safety > 0.0 && d->substep_safety <= 1.0))
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
@@ -178,6 +182,31 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
     return WC_OK;
 }
 
+/* Positions after the step into nx/ny/nz by the world's integrator; the
+ * large-step integrators make their buffers at their first step. */
+static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_fraction,
+                                 int threads)
+{
+    wc_cloth *cl = w->cloths[c];
+    int32_t bad;
+    switch (w->def.integrator) {
+    case WC_INTEGRATOR_XPBD:
+        if (!cl->xpbd && !(cl->xpbd = wc_xpbd_state_create(cl))) break;
+        bad = wc_integrate_xpbd(cl, dt, pin_fraction, threads);
+        return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
+    case WC_INTEGRATOR_IMPLICIT:
+        if (!cl->implicit && !(cl->implicit = wc_implicit_state_create(cl))) break;
+        bad = wc_integrate_implicit(cl, dt, pin_fraction, threads);
+        return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
+    default:
+        bad = wc_integrate_verlet(cl, dt, pin_fraction, threads);
+        return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
+    }
+    return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                   "out of memory for the integrator buffers of cloth %d; the world keeps its "
+                   "last good state", (int)c);
+}
+
 /* One step of the whole world, top to bottom: forces (with the wet pull of
  * the last step's contacts), integration, collisions (with colliders, then
  * each cloth with itself; wet friction acts in their response), the wet
@@ -193,8 +222,8 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
         if (w->cloths[c]->wet_forces) wc_wet_forces(w->cloths[c], threads);
     }
     for (int32_t c = 0; c < w->cloth_count; ++c) {
-        int32_t bad = wc_integrate_verlet(w->cloths[c], dt, pin_fraction, threads);
-        if (bad >= 0) return non_finite_error(w, dt, c, bad, "integration");
+        wc_status s = integrate_cloth(w, c, dt, pin_fraction, threads);
+        if (s) return s;
     }
     int colliding = w->collider_count > 0 || any_self_collision(w);
     if (colliding) {

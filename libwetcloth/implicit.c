@@ -1,0 +1,380 @@
+#include "implicit.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "buckling.h"
+#include "integrate.h"
+#include "parallel.h"
+
+/* The solve stops when |r| <= CG_TOLERANCE |b|. The right-hand side is the
+ * step's momentum change h f; 1e-8 of it leaves velocity errors far below
+ * what the step's own O(h) error is (tests/test_integrators.c: free fall
+ * within 1e-7 of the closed form's lag), at a few tens of iterations on
+ * cotton-like cloth. */
+#define CG_TOLERANCE 1e-8
+/* A cap for pathological systems; the step uses the last iterate, which is
+ * still a descent toward the solution. */
+#define CG_MAX_ITERATIONS 1000
+/* Dot products sum fixed chunks of this many values, then the chunks in
+ * order: the same rounding for any thread count. */
+#define CHUNK 2048
+
+struct wc_implicit_state {
+    int32_t n, links, chunks;
+    /// Ends of each link, stretch links first, then bend links.
+    int32_t *end_a, *end_b;
+    /// Per link: B = h^2 K + h c u u^T as xx, xy, xz, yy, yz, zz, and
+    /// K (v0_a - v0_b), K = -df_a/dx_a.
+    double *block, *kv;
+    /// Per particle: m + h drag A (the diagonal of M - h df/dv from drag),
+    /// and the inverse of the whole 3 x 3 diagonal block (6 values).
+    double *mass_diag, *precond;
+    /// 3n vectors, xyz interleaved: start velocity, known dv of pins,
+    /// right-hand side, solution, residual, preconditioned residual,
+    /// search direction, matrix times direction.
+    double *v0, *fixed, *rhs, *y, *r, *z, *p, *q;
+    double *partial;
+    int32_t last_iterations;
+    double last_residual;
+};
+
+void wc_implicit_state_destroy(wc_implicit_state *s)
+{
+    if (!s) return;
+    double *arrays[] = {s->block, s->kv, s->mass_diag, s->precond, s->v0, s->fixed, s->rhs,
+                        s->y, s->r, s->z, s->p, s->q, s->partial};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
+    wc_free(s->end_a);
+    wc_free(s->end_b);
+    wc_free(s);
+}
+
+wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
+{
+    wc_implicit_state *s = wc_alloc_array(1, sizeof *s);
+    if (!s) return NULL;
+    const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
+    size_t n = (size_t)c->particle_count, links = (size_t)st->count + (size_t)bd->count;
+    s->n = c->particle_count;
+    s->links = (int32_t)links;
+    s->chunks = (int32_t)((3 * n + CHUNK - 1) / CHUNK);
+    s->end_a = wc_alloc_array(links, sizeof *s->end_a);
+    s->end_b = wc_alloc_array(links, sizeof *s->end_b);
+    s->block = wc_alloc_array(6 * links, sizeof(double));
+    s->kv = wc_alloc_array(3 * links, sizeof(double));
+    s->mass_diag = wc_alloc_array(n, sizeof(double));
+    s->precond = wc_alloc_array(6 * n, sizeof(double));
+    double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r, &s->z, &s->p, &s->q};
+    int ok = 1;
+    for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
+        ok &= (*vectors[i] = wc_alloc_array(3 * n, sizeof(double))) != NULL;
+    s->partial = wc_alloc_array((size_t)s->chunks, sizeof(double));
+    if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
+        !s->partial) {
+        wc_implicit_state_destroy(s);
+        return NULL;
+    }
+    for (int32_t e = 0; e < st->count; ++e) s->end_a[e] = st->a[e], s->end_b[e] = st->b[e];
+    for (int32_t e = 0; e < bd->count; ++e)
+        s->end_a[st->count + e] = bd->a[e], s->end_b[st->count + e] = bd->b[e];
+    return s;
+}
+
+int32_t wc_implicit_last_iterations(const wc_implicit_state *s) { return s->last_iterations; }
+double wc_implicit_last_residual(const wc_implicit_state *s) { return s->last_residual; }
+
+/* d|f|/d(compression) of the ramped buckling force, N/m, >= 0 (the force
+ * grows as the link shortens): the axial stiffness of a compressed bend
+ * link. From the same table as the force: dPhi/dgap is the derivative of
+ * the piece's polynomial. In the onset ramp the force is linear in the gap. */
+static double buckling_slope(double d, double l, double R)
+{
+    double gap = (l - d) / l;
+    if (!(gap > 0.0)) return 0.0;
+    if (gap < WC_BUCKLING_ONSET_RAMP)
+        return R / (l * l * l) * wc_buckling_phi_of_gap(WC_BUCKLING_ONSET_RAMP) / WC_BUCKLING_ONSET_RAMP;
+    double scaled = gap * WC_BUCKLING_PIECES;
+    if (scaled > WC_BUCKLING_PIECES) scaled = WC_BUCKLING_PIECES;
+    int k = (int)scaled;
+    if (k == WC_BUCKLING_PIECES) k = WC_BUCKLING_PIECES - 1;
+    const double *coef = wc_buckling_table[k];
+    double t = scaled - k, slope = WC_BUCKLING_DEGREE * coef[WC_BUCKLING_DEGREE];
+    for (int i = WC_BUCKLING_DEGREE - 1; i >= 1; --i) slope = slope * t + i * coef[i];
+    slope *= WC_BUCKLING_PIECES;
+    return slope > 0.0 ? R / (l * l * l) * slope : 0.0;
+}
+
+static void set_block(double *b, double along, double across, double ux, double uy, double uz)
+{
+    /* along u u^T + across I */
+    b[0] = along * ux * ux + across, b[1] = along * ux * uy, b[2] = along * ux * uz;
+    b[3] = along * uy * uy + across, b[4] = along * uy * uz, b[5] = along * uz * uz + across;
+}
+
+static void block_times(const double *b, double x, double y, double z, double out[3])
+{
+    out[0] = b[0] * x + b[1] * y + b[2] * z;
+    out[1] = b[1] * x + b[3] * y + b[4] * z;
+    out[2] = b[2] * x + b[4] * y + b[5] * z;
+}
+
+/* Each link's stiffness block K = -df_a/dx_a and B = h^2 K + h C:
+ *   stretch, taut (d > l): K = k [(l/d) u u^T + (1 - l/d) I], positive
+ *     definite; slack: none (tension only);
+ *   bend, compressed: K = k_b u u^T with k_b the buckling force's slope;
+ *     the transverse term -(f/d)(I - u u^T) is left out: the force pushes
+ *     the ends apart, so that term is negative and would make M - h^2 df/dx
+ *     indefinite (Choi & Ko 2002, section 4.2);
+ *   stretch dashpots: C = c u u^T, taut or slack, as in forces.c. */
+static void link_blocks(const wc_cloth *c, wc_implicit_state *s, double h, int threads)
+{
+    (void)threads;
+    const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
+    int32_t ns = st->count, links = s->links;
+    const double *v0 = s->v0;
+#pragma omp parallel for schedule(static) num_threads(threads) if (links >= WC_PARALLEL_MIN)
+    for (int32_t e = 0; e < links; ++e) {
+        int32_t a = s->end_a[e], b = s->end_b[e];
+        double dx = c->x[a] - c->x[b], dy = c->y[a] - c->y[b], dz = c->z[a] - c->z[b];
+        double d = sqrt(dx * dx + dy * dy + dz * dz);
+        double along = 0.0, across = 0.0, damp = 0.0;
+        double ux = 0.0, uy = 0.0, uz = 0.0;
+        if (d > 0.0) ux = dx / d, uy = dy / d, uz = dz / d;
+        if (e < ns) {
+            double l = st->rest[e], k = c->stretch_k[e];
+            if (d > l) along = k * l / d, across = k * (1.0 - l / d);
+            if (c->stretch_c && d > 0.0) damp = c->stretch_c[e];
+        } else {
+            int32_t f = e - ns;
+            along = buckling_slope(d, bd->rest[f], c->bend_r[f]);
+            if (!(d > 0.0)) along = 0.0;
+        }
+        double *kv = s->kv + 3 * (size_t)e, *blk = s->block + 6 * (size_t)e;
+        set_block(blk, along, across, ux, uy, uz);
+        block_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
+                    v0[3 * a + 2] - v0[3 * b + 2], kv);
+        set_block(blk, h * h * along + h * damp, h * h * across, ux, uy, uz);
+    }
+}
+
+/* Start velocity (as forces.c computes it) and, for pins, the known change
+ * of velocity that takes them to their targets. */
+static void start_velocities(const wc_cloth *c, wc_implicit_state *s, double h,
+                             double pin_fraction, int threads)
+{
+    (void)threads;
+    int32_t n = c->particle_count;
+    int first = !c->has_history;
+    double inv_prev = first ? 0.0 : 1.0 / c->dt_prev;
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
+    for (int32_t i = 0; i < n; ++i) {
+        double *v = s->v0 + 3 * (size_t)i, *fx = s->fixed + 3 * (size_t)i;
+        if (first) {
+            v[0] = c->px[i], v[1] = c->py[i], v[2] = c->pz[i];
+        } else {
+            v[0] = (c->x[i] - c->px[i]) * inv_prev;
+            v[1] = (c->y[i] - c->py[i]) * inv_prev;
+            v[2] = (c->z[i] - c->pz[i]) * inv_prev;
+        }
+        fx[0] = fx[1] = fx[2] = 0.0;
+        if (c->pin_slot[i] >= 0) {
+            double p[3];
+            wc_pinned_position(c, c->pin_slot[i], pin_fraction, p);
+            fx[0] = (p[0] - c->x[i]) / h - v[0];
+            fx[1] = (p[1] - c->y[i]) / h - v[1];
+            fx[2] = (p[2] - c->z[i]) / h - v[2];
+        }
+    }
+}
+
+/* Inverse of a symmetric 3 x 3 block (xx, xy, xz, yy, yz, zz); the block
+ * is positive definite (mass plus positive semi-definite link blocks). */
+static void invert_block(const double *m, double *out)
+{
+    double c0 = m[3] * m[5] - m[4] * m[4], c1 = m[2] * m[4] - m[1] * m[5],
+           c2 = m[1] * m[4] - m[2] * m[3];
+    double inv_det = 1.0 / (m[0] * c0 + m[1] * c1 + m[2] * c2);
+    out[0] = c0 * inv_det;
+    out[1] = c1 * inv_det;
+    out[2] = c2 * inv_det;
+    out[3] = (m[0] * m[5] - m[2] * m[2]) * inv_det;
+    out[4] = (m[1] * m[2] - m[0] * m[4]) * inv_det;
+    out[5] = (m[0] * m[3] - m[1] * m[1]) * inv_det;
+}
+
+/* Per free particle, gathered over its links in their fixed order: the
+ * right-hand side h f_i + h^2 (df/dx v0)_i plus what the pins' known dv
+ * contribute, and the preconditioner (the inverse diagonal block). Pinned
+ * rows are zero: their dv is known, not solved for. */
+static void rhs_and_preconditioner(const wc_cloth *c, wc_implicit_state *s, double h,
+                                   int threads)
+{
+    (void)threads;
+    int32_t n = c->particle_count;
+    double drag = c->material.air_drag, h2 = h * h;
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
+    for (int32_t i = 0; i < n; ++i) {
+        double *b = s->rhs + 3 * (size_t)i, *pre = s->precond + 6 * (size_t)i;
+        if (c->pin_slot[i] >= 0) {
+            b[0] = b[1] = b[2] = 0.0;
+            for (int k = 0; k < 6; ++k) pre[k] = 0.0;
+            continue;
+        }
+        double md = c->mass[i] + (drag > 0.0 ? h * drag * c->topology.area[i] : 0.0);
+        s->mass_diag[i] = md;
+        double diag[6] = {md, 0.0, 0.0, md, 0.0, md};
+        double bx = h * c->fx[i], by = h * c->fy[i], bz = h * c->fz[i];
+        for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
+            int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
+            int32_t j = entry >= 0 ? s->end_b[e] : s->end_a[e];
+            const double *blk = s->block + 6 * (size_t)e, *kv = s->kv + 3 * (size_t)e;
+            for (int m = 0; m < 6; ++m) diag[m] += blk[m];
+            double sign = entry >= 0 ? -h2 : h2;
+            bx += sign * kv[0], by += sign * kv[1], bz += sign * kv[2];
+            if (c->pin_slot[j] >= 0) {
+                double t[3];
+                const double *fj = s->fixed + 3 * (size_t)j;
+                block_times(blk, fj[0], fj[1], fj[2], t);
+                bx += t[0], by += t[1], bz += t[2];
+            }
+        }
+        b[0] = bx, b[1] = by, b[2] = bz;
+        invert_block(diag, pre);
+    }
+}
+
+/* out = A in, A = M + h drag A_i + sum_links B (in_i - in_j), over free
+ * particles; in is zero at pins and so is out. */
+static void apply(const wc_cloth *c, const wc_implicit_state *s, const double *in, double *out,
+                  int threads)
+{
+    (void)threads;
+    int32_t n = c->particle_count;
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
+    for (int32_t i = 0; i < n; ++i) {
+        double *o = out + 3 * (size_t)i;
+        if (c->pin_slot[i] >= 0) {
+            o[0] = o[1] = o[2] = 0.0;
+            continue;
+        }
+        const double *vi = in + 3 * (size_t)i;
+        double md = s->mass_diag[i];
+        double ox = md * vi[0], oy = md * vi[1], oz = md * vi[2];
+        for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
+            int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
+            const double *vj = in + 3 * (size_t)(entry >= 0 ? s->end_b[e] : s->end_a[e]);
+            double t[3];
+            block_times(s->block + 6 * (size_t)e, vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2], t);
+            ox += t[0], oy += t[1], oz += t[2];
+        }
+        o[0] = ox, o[1] = oy, o[2] = oz;
+    }
+}
+
+static void precondition(const wc_implicit_state *s, const double *in, double *out, int threads)
+{
+    (void)threads;
+    int32_t n = s->n;
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
+    for (int32_t i = 0; i < n; ++i)
+        block_times(s->precond + 6 * (size_t)i, in[3 * (size_t)i], in[3 * (size_t)i + 1],
+                    in[3 * (size_t)i + 2], out + 3 * (size_t)i);
+}
+
+/* a . b over 3n values, summed in fixed chunks, then the chunks in order. */
+static double dot(const wc_implicit_state *s, const double *a, const double *b, int threads)
+{
+    (void)threads;
+    int64_t len = 3 * (int64_t)s->n;
+    int32_t chunks = s->chunks;
+    double *partial = s->partial;
+#pragma omp parallel for schedule(static) num_threads(threads) if (s->n >= WC_PARALLEL_MIN)
+    for (int32_t k = 0; k < chunks; ++k) {
+        int64_t begin = (int64_t)k * CHUNK, end = begin + CHUNK < len ? begin + CHUNK : len;
+        double sum = 0.0;
+        for (int64_t i = begin; i < end; ++i) sum += a[i] * b[i];
+        partial[k] = sum;
+    }
+    double total = 0.0;
+    for (int32_t k = 0; k < chunks; ++k) total += partial[k];
+    return total;
+}
+
+/* y += alpha p; r -= alpha q. */
+static void update_solution(wc_implicit_state *s, double alpha, int threads)
+{
+    (void)threads;
+    int64_t len = 3 * (int64_t)s->n;
+#pragma omp parallel for schedule(static) num_threads(threads) if (s->n >= WC_PARALLEL_MIN)
+    for (int64_t i = 0; i < len; ++i) {
+        s->y[i] += alpha * s->p[i];
+        s->r[i] -= alpha * s->q[i];
+    }
+}
+
+/* p = z + beta p. */
+static void update_direction(wc_implicit_state *s, double beta, int threads)
+{
+    (void)threads;
+    int64_t len = 3 * (int64_t)s->n;
+#pragma omp parallel for schedule(static) num_threads(threads) if (s->n >= WC_PARALLEL_MIN)
+    for (int64_t i = 0; i < len; ++i) s->p[i] = s->z[i] + beta * s->p[i];
+}
+
+/* Preconditioned conjugate gradients on A y = rhs from y = 0. */
+static void solve(const wc_cloth *c, wc_implicit_state *s, int threads)
+{
+    size_t bytes = 3 * (size_t)s->n * sizeof(double);
+    memset(s->y, 0, bytes);
+    memcpy(s->r, s->rhs, bytes);
+    double bb = dot(s, s->rhs, s->rhs, threads), rr = bb;
+    int32_t it = 0;
+    if (bb > 0.0) {
+        precondition(s, s->r, s->z, threads);
+        memcpy(s->p, s->z, bytes);
+        double rz = dot(s, s->r, s->z, threads);
+        for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
+            apply(c, s, s->p, s->q, threads);
+            double pq = dot(s, s->p, s->q, threads);
+            /* A is positive definite, so pq > 0 unless p = 0 or something
+             * is not finite: then stop, the caller checks the result */
+            if (!(pq > 0.0) || !isfinite(pq)) break;
+            double alpha = rz / pq;
+            update_solution(s, alpha, threads);
+            rr = dot(s, s->r, s->r, threads);
+            precondition(s, s->r, s->z, threads);
+            double rz_next = dot(s, s->r, s->z, threads);
+            update_direction(s, rz_next / rz, threads);
+            rz = rz_next;
+        }
+    }
+    s->last_iterations = it;
+    s->last_residual = bb > 0.0 ? sqrt(rr / bb) : 0.0;
+}
+
+int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, int threads)
+{
+    wc_implicit_state *s = c->implicit;
+    int32_t n = c->particle_count;
+    start_velocities(c, s, dt, pin_fraction, threads);
+    link_blocks(c, s, dt, threads);
+    rhs_and_preconditioner(c, s, dt, threads);
+    solve(c, s, threads);
+    /* v1 = v0 + dv, x1 = x + h v1; pins exactly at their targets */
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
+    for (int32_t i = 0; i < n; ++i) {
+        if (c->pin_slot[i] >= 0) {
+            double p[3];
+            wc_pinned_position(c, c->pin_slot[i], pin_fraction, p);
+            c->nx[i] = p[0], c->ny[i] = p[1], c->nz[i] = p[2];
+            continue;
+        }
+        const double *v = s->v0 + 3 * (size_t)i, *y = s->y + 3 * (size_t)i;
+        c->nx[i] = c->x[i] + dt * (v[0] + y[0]);
+        c->ny[i] = c->y[i] + dt * (v[1] + y[1]);
+        c->nz[i] = c->z[i] + dt * (v[2] + y[2]);
+    }
+    return wc_first_non_finite_xyz(c->nx, c->ny, c->nz, n);
+}

@@ -1,0 +1,34 @@
+/* Semi-implicit backward Euler (WC_INTEGRATOR_IMPLICIT), after Baraff &
+ * Witkin 1998 and Choi & Ko 2002: one linear solve per step,
+ *   (M - h df/dv - h^2 df/dx) dv = h (f + h df/dx v),
+ * with df/dx the stretch links' Jacobian (tension only) and the bend
+ * links' axial stiffness (their transverse term dropped, as Choi & Ko do,
+ * because it would make the matrix indefinite), df/dv the stretch dashpots
+ * and air drag. Block-Jacobi preconditioned conjugate gradients, matrix-free,
+ * gathered per particle with fixed-order reductions: the same bits for any
+ * thread count. */
+#ifndef WC_IMPLICIT_H
+#define WC_IMPLICIT_H
+
+#include "cloth.h"
+
+typedef struct wc_implicit_state wc_implicit_state;
+
+/// Buffers for a cloth's solve. NULL when out of memory.
+wc_implicit_state *wc_implicit_state_create(const wc_cloth *cloth);
+
+void wc_implicit_state_destroy(wc_implicit_state *state);
+
+/// Conjugate-gradient iterations of the last solve, and its residual
+/// relative to the right-hand side.
+int32_t wc_implicit_last_iterations(const wc_implicit_state *state);
+double wc_implicit_last_residual(const wc_implicit_state *state);
+
+/// Writes the positions after a step of dt into cloth->nx/ny/nz, x + dt v1,
+/// with v1 from the solve above and the forces in cloth->fx/fy/fz. Pinned
+/// particles go where Verlet puts them. Returns the index of the first
+/// particle whose new position is not finite, or -1 when all are.
+/// cloth->implicit must exist.
+int32_t wc_integrate_implicit(wc_cloth *cloth, double dt, double pin_fraction, int threads);
+
+#endif
