@@ -198,15 +198,25 @@ class World:
     threads        OpenMP threads inside a step, 0 = OpenMP's default
     substep_safety fraction of the stable step advance() uses, (0, 1]
     max_substeps   most substeps advance() may choose, 1 .. 10^7
+    integrator     "verlet" (default, explicit), "xpbd" (strain-limited
+                   stretch) or "implicit" (semi-implicit backward Euler);
+                   see docs/model.md
 
     Use as a context manager, or call close(), to free the C world at once;
     otherwise it is freed when the World and all its cloths and colliders
     are garbage. After close() every call raises WetclothError.
     """
 
+    INTEGRATORS = {"verlet": "WC_INTEGRATOR_VERLET", "xpbd": "WC_INTEGRATOR_XPBD",
+                   "implicit": "WC_INTEGRATOR_IMPLICIT"}
+
     def __init__(self, gravity=(0.0, 0.0, -9.81), threads=0, substep_safety=0.9,
-                 max_substeps=100000):
+                 max_substeps=100000, integrator="verlet"):
+        if not isinstance(integrator, str) or integrator not in World.INTEGRATORS:
+            raise _bad("integrator must be one of %s but is %r"
+                       % (", ".join(repr(k) for k in World.INTEGRATORS), integrator))
         d = lib.wc_world_def_default()
+        d.integrator = getattr(lib, World.INTEGRATORS[integrator])
         d.gravity = list(_vector("gravity", gravity, 3))
         d.thread_count = _int32("threads", threads)
         d.substep_safety = _float("substep_safety", substep_safety)

@@ -170,7 +170,7 @@ def check_vector(fail, key, v, size):
 
 MATERIAL_FIELDS = list(_core._MATERIAL_FIELDS)
 SCENE_FIELDS = ["description", "format_version", "duration", "fps", "substeps", "threads",
-                "gravity", "start_frame", "cloths", "colliders"]
+                "gravity", "start_frame", "integrator", "cloths", "colliders"]
 CLOTH_FIELDS = ["name", "grid", "obj", "material", "wetness", "pins", "pin_keyframes",
                 "self_collision"]
 GRID_FIELDS = ["nu", "nv", "size", "center", "axis_u", "axis_v"]
@@ -261,6 +261,7 @@ def from_dict(data, source, base_dir):
     s.substeps = r.integer("substeps", 0, minimum=0, maximum=10 ** 7)
     s.threads = r.integer("threads", 0, minimum=0, maximum=1024)
     s.gravity = r.vector("gravity", 3, [0.0, 0.0, -9.81])
+    s.integrator = r.string("integrator", "verlet", choices=["verlet", "xpbd", "implicit"])
     s.start_frame = r.number("start_frame", 1.0)
     if s.duration * s.fps > 1e6:
         r.fail("duration", "duration x fps must be at most 1e6 frames, found %g" %
@@ -434,7 +435,8 @@ def build(scene, threads=None):
             raise SceneError(scene.source, where, str(e)) from None
 
     world = guarded("gravity", World, gravity=scene.gravity,
-                    threads=scene.threads if threads is None else threads)
+                    threads=scene.threads if threads is None else threads,
+                    integrator=scene.integrator)
     b = Built(scene, world)
     try:
         for c in scene.cloths:
