@@ -45,9 +45,22 @@ static void cell_range(const double box[6], double inv_cell, int32_t lo[3], int3
     }
 }
 
+/* Cells in a range, saturated: the product of three spans of up to 2e9+1
+ * cells each (clamped coordinates of an exploded or huge box) overflows
+ * int64, and a wrapped count once sent such a query cell by cell through
+ * ~1e27 cells. Any span over CELLS_SATURATE makes the range count as that
+ * many cells, far above both limits below. */
+#define CELLS_SATURATE ((int64_t)1 << 20)
 static int64_t cells_in(const int32_t lo[3], const int32_t hi[3])
 {
-    return ((int64_t)hi[0] - lo[0] + 1) * ((int64_t)hi[1] - lo[1] + 1) * ((int64_t)hi[2] - lo[2] + 1);
+    int64_t cells = 1;
+    for (int k = 0; k < 3; ++k) {
+        int64_t span = (int64_t)hi[k] - lo[k] + 1;
+        if (span > CELLS_SATURATE) return CELLS_SATURATE;
+        cells *= span;
+        if (cells > CELLS_SATURATE) return CELLS_SATURATE;
+    }
+    return cells;
 }
 
 /* Visits every cell of an item's range: pass 0 counts, pass 1 writes. */

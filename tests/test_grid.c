@@ -64,8 +64,30 @@ static void scene(int32_t n, double item_size, double cell_size, double query_si
     free(expect);
 }
 
+/* Boxes as large as an exploded cloth makes them (1e12 m, 1e300 m across):
+ * the query must answer with the brute-force result, at once, rather than
+ * walk its cells (a cell count that overflowed once made it hang). The
+ * huge item goes to the large list; the huge query scans. */
+static void huge_boxes(void)
+{
+    double boxes[18] = {0.0, 0.0, 0.0, 0.1, 0.1, 0.1,
+                        -1e12, -1e12, -1e12, 1e12, 1e12, 1e12,
+                        5.0, 5.0, 5.0, 5.1, 5.1, 5.1};
+    wc_grid g;
+    wc_grid_init(&g);
+    CHECK(wc_grid_build(&g, boxes, 3, 0.05) == WC_OK, "build failed");
+    double query[6] = {-1e300, -1e300, -1e300, 1e300, 1e300, 1e300}, small[6] = {0.05, 0.05, 0.05, 0.06, 0.06, 0.06};
+    int32_t found[3] = {-1, -1, -1};
+    int32_t n = wc_grid_query(&g, query, found, 3);
+    CHECK(n == 3 && found[0] == 0 && found[1] == 1 && found[2] == 2, "huge query: %d items", (int)n);
+    n = wc_grid_query(&g, small, found, 3);
+    CHECK(n == 2 && found[0] == 0 && found[1] == 1, "small query: %d items", (int)n);
+    wc_grid_free(&g);
+}
+
 int main(void)
 {
+    huge_boxes();
     scene(2000, 0.02, 0.05, 0.05, 3000);  /* cloth-like: small items, small queries */
     scene(500, 0.1, 0.02, 0.1, 2000);     /* items spanning many cells (the large list) */
     scene(3000, 0.01, 0.03, 1.5, 40);     /* queries spanning the whole grid (the scan) */
