@@ -574,6 +574,16 @@ typedef struct wc_step_stats {
     int32_t failsafe_particles;
     /// Particles stuck (wet, in sustained contact) after the step.
     int32_t stuck_particles;
+    /// Wall time in seconds by phase, of the last wc_world_step, or of the
+    /// whole last wc_world_advance (all its substeps together): forces
+    /// (with the wet pull), integration, collisions (colliders and
+    /// self-collision), and the wet response with the commit (stuck marking,
+    /// commit, wicking and drying). >= 0; what they do not cover (argument
+    /// checks, pin bookkeeping) is negligible.
+    double force_seconds;
+    double integrate_seconds;
+    double collide_seconds;
+    double wet_seconds;
 } wc_step_stats;
 
 /// Statistics of the last step.

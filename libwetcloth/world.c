@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "clock.h"
 #include "collide.h"
 #include "collide_features.h"
 #include "forces.h"
@@ -217,19 +218,23 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
 {
     int threads = wc_thread_count(w->def.thread_count);
     memset(&w->stats, 0, sizeof w->stats);
+    double *phase = w->phase_seconds, t0 = wc_clock_seconds(), t1;
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_forces_compute(w->cloths[c], w->def.gravity, threads);
         if (w->cloths[c]->wet_forces) wc_wet_forces(w->cloths[c], threads);
     }
+    t1 = wc_clock_seconds(), phase[0] += t1 - t0, t0 = t1;
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_status s = integrate_cloth(w, c, dt, pin_fraction, threads);
         if (s) return s;
     }
+    t1 = wc_clock_seconds(), phase[1] += t1 - t0, t0 = t1;
     int colliding = w->collider_count > 0 || any_self_collision(w);
     if (colliding) {
         wc_status s = collide(w, dt, share, threads);
         if (s) return s;
     }
+    t1 = wc_clock_seconds(), phase[2] += t1 - t0, t0 = t1;
     if (colliding)
         for (int32_t c = 0; c < w->cloth_count; ++c)
             w->stats.stuck_particles += wc_wet_mark_stuck(w->cloths[c]);
@@ -239,8 +244,21 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
         const wc_material *m = &w->cloths[c]->material;
         if (m->wicking > 0.0 || m->drying > 0.0) wc_wet_update(w->cloths[c], dt);
     }
+    phase[3] += wc_clock_seconds() - t0;
     w->time += dt;
     return WC_OK;
+}
+
+/* Before a step or an advance: no phase time yet. */
+static void start_timing(wc_world *w) { memset(w->phase_seconds, 0, sizeof w->phase_seconds); }
+
+/* After it: the phase times of all its steps into the stats. */
+static void finish_timing(wc_world *w)
+{
+    w->stats.force_seconds = w->phase_seconds[0];
+    w->stats.integrate_seconds = w->phase_seconds[1];
+    w->stats.collide_seconds = w->phase_seconds[2];
+    w->stats.wet_seconds = w->phase_seconds[3];
 }
 
 /* After an advance, pins start the next one from where they are. A
@@ -273,7 +291,9 @@ wc_status wc_world_step(wc_world *w, double dt)
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
     wc_status s = check_step_length(w, "wc_world_step: dt", dt);
     if (s) return s;
+    start_timing(w);
     s = world_step(w, dt, 1.0, 1.0);
+    finish_timing(w);
     settle_pins(w);
     return s;
 }
@@ -306,8 +326,10 @@ wc_status wc_world_advance(wc_world *w, double frame_dt, int32_t substeps)
         substeps = needed < 1.0 ? 1 : (int32_t)needed;
     }
     double dt = frame_dt / substeps;
+    start_timing(w);
     for (int32_t k = 0; k < substeps && !s; ++k)
         s = world_step(w, dt, 1.0 / (substeps - k), (double)(k + 1) / substeps);
+    finish_timing(w);
     settle_pins(w);
     w->last_substeps = substeps;
     return s;
@@ -321,6 +343,7 @@ int32_t wc_world_cloth_count(const wc_world *w) { return w ? w->cloth_count : 0;
 
 wc_step_stats wc_world_get_stats(const wc_world *w)
 {
-    wc_step_stats none = {0, 0, 0, 0};
+    wc_step_stats none;
+    memset(&none, 0, sizeof none);
     return w ? w->stats : none;
 }

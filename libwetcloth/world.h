@@ -16,6 +16,10 @@ struct wc_world {
     double time;
     int32_t last_substeps;
     wc_step_stats stats;
+    /// Per-phase wall time summed over the running step or advance (the
+    /// stats of each substep are cleared, these are not): forces,
+    /// integration, collisions, wet response and commit.
+    double phase_seconds[4];
     /// Message of the last failed call. Calls that take a const world still
     /// report here: the world itself is never const-defined (it comes from
     /// wc_world_create), so writing through a cast pointer is well defined.

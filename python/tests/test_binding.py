@@ -391,8 +391,27 @@ def test_stats_keys():
         s = w.stats
         assert set(s) == {"steps", "time", "last_substeps", "collider_contacts",
                           "cloth_contacts", "failsafe_particles", "stuck_particles",
-                          "step_seconds"}
+                          "step_seconds", "phase_seconds"}
         assert s["steps"] == s["last_substeps"] > 0 and s["step_seconds"] > 0
+
+
+def test_phase_seconds_split_the_step_time():
+    """The library's per-phase times are >= 0, cover all substeps of the
+    advance (forces and integration always run, so they are > 0), and add
+    up to no more than the wall time the binding measured around the call."""
+    with World() as w:
+        w.add_grid_cloth(30, 30)
+        w.add_sphere((0.0, 0.0, -0.3), 0.25)
+        w.advance(1 / 24)
+        s = w.stats
+        phases = s["phase_seconds"]
+        assert set(phases) == {"forces", "integrate", "collide", "wet"}
+        assert all(v >= 0.0 for v in phases.values())
+        assert phases["forces"] > 0 and phases["integrate"] > 0 and phases["collide"] > 0
+        assert sum(phases.values()) <= s["step_seconds"]
+        w.step(w.stable_dt())
+        one = w.stats["phase_seconds"]
+        assert sum(one.values()) < sum(phases.values())  # one step, not the whole advance
 
 
 def test_threads_give_identical_results():

@@ -477,7 +477,9 @@ class World:
         """What the world has done: steps (successful steps so far), time
         (simulated, s), last_substeps, and from the last step collider_contacts,
         cloth_contacts, failsafe_particles, stuck_particles; step_seconds is
-        the wall time spent inside step() and advance()."""
+        the wall time spent inside step() and advance(); phase_seconds is the
+        library's wall time by phase (forces, integrate, collide, wet) of the
+        last step(), or of all substeps of the last advance()."""
         h = self._handle()
         s = lib.wc_world_get_stats(h)
         return {
@@ -489,6 +491,12 @@ class World:
             "failsafe_particles": int(s.failsafe_particles),
             "stuck_particles": int(s.stuck_particles),
             "step_seconds": self._step_seconds,
+            "phase_seconds": {
+                "forces": float(s.force_seconds),
+                "integrate": float(s.integrate_seconds),
+                "collide": float(s.collide_seconds),
+                "wet": float(s.wet_seconds),
+            },
         }
 
 

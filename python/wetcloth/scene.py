@@ -543,6 +543,7 @@ def run(scene, out_dir, progress=True, check="every", threads=None, frames=None,
                 sim_seconds += wall
                 s = world.stats
                 record = {"frame": f, "substeps": used, "seconds": wall,
+                          "phase_seconds": s["phase_seconds"],
                           "collider_contacts": s["collider_contacts"],
                           "cloth_contacts": s["cloth_contacts"],
                           "failsafe_particles": s["failsafe_particles"],
@@ -624,6 +625,9 @@ def _stats(scene, built, per_frame, frame_count, sim_seconds, check_seconds, tot
             "simulation_per_frame_max": max(secs),
             "simulation_per_step_mean": sim_seconds / max(1, built.world.stats["steps"]),
             "intersection_checks": check_seconds,
+            # the library's own split of the simulation time
+            "by_phase": {k: sum(r["phase_seconds"][k] for r in per_frame)
+                         for k in ("forces", "integrate", "collide", "wet")},
         },
         "contacts": {
             "collider_final": per_frame[-1]["collider_contacts"],
