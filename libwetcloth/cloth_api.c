@@ -461,7 +461,7 @@ wc_status wc_cloth_set_pin_targets(wc_world *w, int32_t cloth, const double *xyz
     if (!c) return lookup_status(w, cloth);
     wc_status s = check_finite_xyz(w, xyz, count, "wc_cloth_set_pin_targets");
     if (s) return s;
-    memcpy(c->pins.to, xyz, 3 * (size_t)count * sizeof *xyz);
+    if (count) memcpy(c->pins.to, xyz, 3 * (size_t)count * sizeof *xyz); /* no pins: to is NULL */
     return WC_OK;
 }
 

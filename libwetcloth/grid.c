@@ -22,11 +22,13 @@ void wc_grid_free(wc_grid *g)
     wc_grid_init(g);
 }
 
-/* Cell coordinate of a value; clamped so huge coordinates cannot overflow. */
+/* Cell coordinate of a value; clamped so huge coordinates cannot overflow,
+ * and NaN (a step going non-finite, caught after collision) goes to the
+ * low end instead of an undefined conversion. */
 static int32_t cell_of(double value, double inv_cell)
 {
     double c = floor(value * inv_cell);
-    if (c < -1e9) c = -1e9;
+    if (!(c >= -1e9)) c = -1e9;
     if (c > 1e9) c = 1e9;
     return (int32_t)c;
 }

@@ -118,7 +118,8 @@ static wc_status list_elements(wc_near_list *l, wc_near_elements *out, const int
         element_box(l, particles + (size_t)per * (size_t)e, per, r, box);
         if (!wc_boxes_overlap(box, bounds)) continue;
         int32_t room = (int32_t)(out->found_capacity - used);
-        int32_t n = wc_grid_query(grid, box, out->found + used, room);
+        /* no buffer yet (NULL): query the count only; NULL + 0 is undefined */
+        int32_t n = wc_grid_query(grid, box, out->found ? out->found + used : NULL, room);
         if (n == 0) continue;
         if (n > room) {
             if (!reserve(&out->found, &out->found_capacity, used + n)) return WC_ERROR_OUT_OF_MEMORY;

@@ -312,6 +312,8 @@ int32_t wc_wet_mark_stuck(wc_cloth *c)
  * Each particle gathers from its links into a second buffer (Jacobi), so
  * the order of particles does not matter. Drying: w *= exp(-rate dt),
  * exact for dw/dt = -rate w. */
+#define WICKING_MAX_SUBSTEPS 64
+
 void wc_wet_update(wc_cloth *c, double dt)
 {
     const wc_material *m = &c->material;
@@ -323,19 +325,32 @@ void wc_wet_update(wc_cloth *c, double dt)
             double rate = 0.0;
             for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
                 int32_t e = c->link_list[k] >= 0 ? c->link_list[k] : ~c->link_list[k];
-                if (e < links->count) rate += m->wicking / (links->rest[e] * links->rest[e]);
+                if (e < links->count && links->rest[e] > 0.0)
+                    rate += m->wicking / (links->rest[e] * links->rest[e]);
             }
             if (rate > worst) worst = rate;
         }
-        int substeps = (int)ceil(dt * worst / 0.5);
-        if (substeps < 1) substeps = 1;
-        double h = dt / substeps;
+        /* At most WICKING_MAX_SUBSTEPS: beyond them (links far shorter than
+         * the cloth's scale, e.g. near-duplicate vertices) diffusion is
+         * slowed to what that many substeps keep stable, instead of a step
+         * that never ends. */
+        double needed = ceil(dt * worst / 0.5), slow = 1.0;
+        int substeps = 1;
+        if (!isfinite(needed)) {
+            substeps = 0; /* links so short that 1 / l^2 overflows: no wicking */
+        } else if (needed > WICKING_MAX_SUBSTEPS) {
+            substeps = WICKING_MAX_SUBSTEPS;
+            slow = WICKING_MAX_SUBSTEPS / needed;
+        } else if (needed > 1.0) {
+            substeps = (int)needed;
+        }
+        double h = substeps ? dt / substeps * slow : 0.0;
         for (int sub = 0; sub < substeps; ++sub) {
             for (int32_t i = 0; i < n; ++i) {
                 double change = 0.0;
                 for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
                     int32_t e = c->link_list[k] >= 0 ? c->link_list[k] : ~c->link_list[k];
-                    if (e >= links->count) continue;
+                    if (e >= links->count || !(links->rest[e] > 0.0)) continue;
                     int32_t j = links->a[e] == i ? links->b[e] : links->a[e];
                     change += (c->wetness[j] - c->wetness[i]) / (links->rest[e] * links->rest[e]);
                 }

@@ -1,0 +1,117 @@
+/* Regressions found by fuzzing (issue 9, tests/fuzz): each case is what a
+ * fuzz input reduced to, checked in the normal and the sanitizer builds. */
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#include "grid.h"
+#include "test_util.h"
+#include "wetcloth.h"
+
+static wc_world *world(void)
+{
+    wc_world_def def = wc_world_def_default();
+    def.thread_count = 1;
+    wc_world *w = NULL;
+    wc_message msg;
+    CHECK(wc_world_create(&def, &w, &msg) == WC_OK, "world: %s", msg.text);
+    return w;
+}
+
+/* wc_cloth_set_pin_targets with no pins and count 0 is a valid no-op (it
+ * passed a NULL destination to memcpy: undefined behaviour). */
+static void pin_targets_without_pins(void)
+{
+    wc_world *w = world();
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = 4;
+    int32_t c;
+    CHECK(wc_world_add_grid_cloth(w, &g, &c) == WC_OK, "grid: %s", wc_world_last_error(w));
+    double none[3] = {0.0, 0.0, 0.0};
+    CHECK(wc_cloth_set_pin_targets(w, c, none, 0) == WC_OK, "no pins, no targets: %s",
+          wc_world_last_error(w));
+    CHECK(wc_cloth_set_pin_targets(w, c, none, 1) == WC_ERROR_INVALID_ARGUMENT,
+          "one target for no pins must be refused");
+    CHECK(wc_world_last_error(w)[0] != '\0', "and say why");
+    wc_world_destroy(w);
+}
+
+/* The broadphase grid takes NaN boxes (positions of a step that is going
+ * non-finite, caught after collision) and boxes spanning the whole double
+ * range (their cell count overflowed int64) without undefined behaviour,
+ * and a query still finds what it overlaps. */
+static void grid_awkward_boxes(void)
+{
+    double boxes[4 * 6] = {
+        0.0, 0.0, 0.0, 0.1, 0.1, 0.1,                         /* ordinary */
+        NAN, NAN, NAN, NAN, NAN, NAN,                         /* NaN */
+        -1e300, -1e300, -1e300, 1e300, 1e300, 1e300,          /* everything */
+        -INFINITY, 0.0, 0.0, INFINITY, 0.05, 0.05,            /* infinite */
+    };
+    wc_grid g;
+    wc_grid_init(&g);
+    CHECK(wc_grid_build(&g, boxes, 4, 0.1) == WC_OK, "build");
+    int32_t found[8];
+    double q[6] = {0.05, 0.05, 0.05, 0.06, 0.06, 0.06};
+    int32_t n = wc_grid_query(&g, q, found, 8);
+    CHECK(n == 3 && found[0] == 0 && found[1] == 2 && found[2] == 3,
+          "query finds the ordinary, the everything and the infinite box (%d found)", (int)n);
+    double huge[6] = {-1e300, -1e300, -1e300, 1e300, 1e300, 1e300};
+    n = wc_grid_query(&g, huge, found, 8);
+    CHECK(n == 3, "a query over everything finds the 3 boxes that are not NaN (%d)", (int)n);
+    double nan_box[6] = {NAN, NAN, NAN, NAN, NAN, NAN};
+    n = wc_grid_query(&g, nan_box, found, 8);
+    CHECK(n >= 0 && n <= 4, "a NaN query returns a count (%d)", (int)n);
+    wc_grid_free(&g);
+}
+
+/* Wicking over a link far shorter than the rest of the cloth: with 1e-6 m
+ * next to 0.5 m it needed about 1e9 diffusion substeps, and the step did
+ * not end in minutes; with 1e-9 m the count overflowed int (undefined).
+ * It now takes at most 64 and the wetness stays in [0, 1]. */
+static void wicking_tiny_link(double side)
+{
+    wc_world *w = world();
+    /* two triangles: one of 0.5 m, one of `side`, well shaped */
+    double v[3 * 6] = {0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.5, 0.0,
+                       1.0, 1.0, 0.0, 1.0 + side, 1.0, 0.0, 1.0, 1.0 + side, 0.0};
+    int32_t f[6] = {0, 1, 2, 3, 4, 5};
+    wc_mesh_cloth_def d = wc_mesh_cloth_def_default();
+    d.vertices = v;
+    d.vertex_count = 6;
+    d.faces = f;
+    d.face_count = 2;
+    d.material.wicking = 1.0;
+    d.material.stretch_stiffness = 0.0; /* gravity alone: the step is stable */
+    d.material.bend_stiffness = 0.0;
+    int32_t c;
+    wc_status s = wc_world_add_mesh_cloth(w, &d, &c);
+    CHECK(s == WC_OK, "cloth with a triangle of %g m: %s", side, wc_world_last_error(w));
+    if (s == WC_OK) {
+        int32_t n = wc_cloth_particle_count(w, c);
+        double wet[6] = {1.0, 0.0, 0.5, 0.0, 1.0, 0.25};
+        CHECK(wc_cloth_set_wetness(w, c, wet, n) == WC_OK, "wetness: %s", wc_world_last_error(w));
+        clock_t start = clock();
+        for (int k = 0; k < 3; ++k) {
+            wc_status st = wc_world_step(w, 1e-4);
+            CHECK(st == WC_OK, "step %d: %s", k, wc_world_last_error(w));
+        }
+        double seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
+        CHECK(seconds < 5.0, "links of %g m: 3 steps took %.1f s", side, seconds);
+        double out[6];
+        CHECK(wc_cloth_get_wetness(w, c, out, n) == WC_OK, "get wetness");
+        for (int32_t i = 0; i < n; ++i)
+            CHECK(isfinite(out[i]) && out[i] >= 0.0 && out[i] <= 1.0, "wetness %d is %g", (int)i,
+                  out[i]);
+    }
+    wc_world_destroy(w);
+}
+
+int main(void)
+{
+    pin_targets_without_pins();
+    grid_awkward_boxes();
+    wicking_tiny_link(1e-6);
+    wicking_tiny_link(1e-9);
+    return test_report("test_robustness");
+}
