@@ -1,0 +1,147 @@
+"""Blender's cloth and libwetcloth side by side, in one process (issue 8).
+
+Run by report.py under the Python that has bpy 4.5 (.venv-blender), with
+PYTHONPATH giving the wetcloth package (and cffi) and WETCLOTH_LIBRARY the
+library. Prints a markdown section; --json writes the figures.
+
+Scene (Table 3.2's, as in NOTES): an n x n grid cloth 1 m wide, 0.6 m above
+the 114-vertex UV sphere (16 x 8, radius 0.3 m), 24 fps. Blender: the Cloth
+modifier with its defaults and quality 5 (5 steps per frame), the sphere with
+a Collision modifier, self-collision on or off; the frames are evaluated in
+order with scene.frame_set. Ours: the same geometry with the default
+material, automatic substeps. Both in this process, one after the other, 1
+thread for ours (Blender uses its own thread pool). The materials are not
+the same (Blender's defaults against our cotton): the ratio compares what a
+user gets from each with default settings on this scene.
+
+Reported: wall time per simulated frame of each and their ratio; our error
+(RMS over particles and frames of the distance to our reference, Verlet at
+8x our automatic substeps, / 1 m); intersections at the last frame on both
+sides, counted by libwetcloth's independent checker (Blender's final mesh is
+loaded into a checker-only world).
+"""
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+
+os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="wc-bench-blender-"))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+import wetcloth  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import scenes  # noqa: E402
+
+
+def grid(n, z=0.6):
+    a = np.arange(n) / (n - 1) - 0.5
+    x, y = np.meshgrid(a, a)
+    v = np.c_[x.ravel(), y.ravel(), np.full(n * n, z)]
+    q = [(j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i)
+         for j in range(n - 1) for i in range(n - 1)]
+    return v, np.array(q, np.int32)
+
+
+def blender_run(n, self_collision, frames):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.fps = 24
+    scene.frame_start = 1
+    scene.frame_end = frames + 1
+    sv, st = scenes.uv_sphere()
+    me = bpy.data.meshes.new("sphere")
+    me.from_pydata(sv.tolist(), [], st.tolist())
+    me.update()
+    sphere = bpy.data.objects.new("sphere", me)
+    scene.collection.objects.link(sphere)
+    sphere.modifiers.new("Collision", "COLLISION")
+    v, q = grid(n)
+    me = bpy.data.meshes.new("cloth")
+    me.from_pydata(v.tolist(), [], q.tolist())
+    me.update()
+    cloth = bpy.data.objects.new("cloth", me)
+    scene.collection.objects.link(cloth)
+    mod = cloth.modifiers.new("Cloth", "CLOTH")
+    mod.settings.quality = 5
+    mod.collision_settings.use_self_collision = self_collision
+    mod.point_cache.frame_start = 1
+    mod.point_cache.frame_end = frames + 1
+    scene.frame_set(1)
+    t0 = time.perf_counter()
+    for f in range(2, frames + 2):
+        scene.frame_set(f)
+    wall = (time.perf_counter() - t0) / frames
+    dg = bpy.context.evaluated_depsgraph_get()
+    ev = cloth.evaluated_get(dg)
+    m = ev.to_mesh()
+    pos = np.empty(3 * len(m.vertices))
+    m.vertices.foreach_get("co", pos)
+    ev.to_mesh_clear()
+    pos = pos.reshape(-1, 3)
+    # Blender's result in our independent checker (no step is taken)
+    w = wetcloth.World(threads=1)
+    w.add_mesh_collider(sv, st)
+    w.add_cloth(pos, q)
+    k = w.count_intersections()
+    w.close()
+    bpy.ops.wm.read_homefile(use_empty=True)
+    return wall, k, bool(np.all(np.isfinite(pos)))
+
+
+def ours(n, self_collision, frames, substeps=0):
+    w, c = scenes.drape(n, self_collision=self_collision, threads=1)
+    out, wall = [], 0.0
+    for _ in range(frames):
+        t0 = time.perf_counter()
+        used = w.advance(scenes.FRAME, substeps)
+        wall += time.perf_counter() - t0
+        out.append(c.positions)
+    k = w.count_intersections()
+    w.close()
+    return wall / frames, np.array(out), k, used
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--json")
+    a = ap.parse_args()
+    cases = [(10, 12)] if a.quick else [(10, 48), (15, 48), (20, 48), (51, 24), (101, 24)]
+    print(f"bpy {bpy.app.version_string}, libwetcloth {wetcloth.__version__}; load average "
+          f"before: {' '.join(open('/proc/loadavg').read().split()[:3])}.")
+    print()
+    print("| particles | self-collision | frames | Blender ms/frame | ours ms/frame | Blender / ours "
+          "| our substeps/frame | our error / size | intersections ours (cloth-cloth, cloth-sphere) "
+          "| intersections Blender |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    rows = []
+    for n, frames in cases:
+        for self_c in (True, False):
+            bw, bk, bfinite = blender_run(n, self_c, frames)
+            ow, opos, ok, sub = ours(n, self_c, frames)
+            _, rpos, _, _ = ours(n, self_c, frames, 8 * sub)
+            d = np.linalg.norm(opos - rpos, axis=2)
+            err = float(np.sqrt(np.mean(d * d)))
+            row = {"particles": n * n, "self": self_c, "frames": frames, "blender_s": bw,
+                   "ours_s": ow, "ratio": bw / ow, "substeps": sub, "error": err,
+                   "ours_intersections": ok, "blender_intersections": bk,
+                   "blender_finite": bfinite}
+            rows.append(row)
+            print(f"| {n * n} | {'on' if self_c else 'off'} | {frames} | {1e3 * bw:.3g} | "
+                  f"{1e3 * ow:.3g} | {bw / ow:.2f} | {sub} | {err:.2e} | "
+                  f"{ok['cloth_cloth']}, {ok['cloth_collider']} | "
+                  f"{bk['cloth_cloth']}, {bk['cloth_collider']} |", flush=True)
+    print()
+    print(f"Load average after: {' '.join(open('/proc/loadavg').read().split()[:3])}.")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(rows, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
