@@ -27,6 +27,13 @@
  * intersecting, and a flat sheet that is not axis-aligned must be found
  * coplanar rather than crossing itself by rounding noise. */
 #define PLANE_EPS 1e-12
+/* Two triangles whose vertices all lie within this fraction of the pair's
+ * size of the other's plane are compared as coplanar (in 2D). Their planes
+ * then meet at an angle of at most ~1e-7 rad along a line their tiny,
+ * rounding-noisy distances place badly: a flat sheet falling freely (its
+ * heights differ by ~1e-11 m after a few hundred steps of rounding) showed
+ * pairs half a cell apart as crossing. 1e-7 of a 3 cm pair is 3 nm. */
+#define COPLANAR_EPS 1e-7
 /* A triangle whose area is below this fraction of its longest edge squared
  * has no usable plane: it is treated as a segment. */
 #define FLAT_EPS 1e-12
@@ -290,6 +297,9 @@ int wc_triangles_intersect(const double p0[3], const double p1[3], const double 
     if (plane_side(p, q0, nq, tol, dp)) return 0;
     if (dq[0] == 0.0 && dq[1] == 0.0 && dq[2] == 0.0) return coplanar_triangles(p, q, np);
     if (dp[0] == 0.0 && dp[1] == 0.0 && dp[2] == 0.0) return coplanar_triangles(p, q, nq);
+    double flat = COPLANAR_EPS * size, off = 0.0;
+    for (int i = 0; i < 3; ++i) off = max2(off, max2(fabs(dq[i]), fabs(dp[i])));
+    if (off <= flat) return coplanar_triangles(p, q, np);
 
     /* Each triangle meets the other's plane in a segment; both segments lie
      * on the line where the planes meet, and the triangles intersect when

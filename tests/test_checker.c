@@ -128,6 +128,24 @@ static void test_triangle_pairs(void)
         for (int k = 0; k < 3; ++k) q[0][k] = 0.3 + 0.4 * u[k] + 0.4 * v[k];
         expect_pair((const double(*)[3])p, (const double(*)[3])q, 1, "slanted coplanar, overlapping");
     }
+    {
+        /* Two triangles of a 64 x 64 sheet falling flat, half a cell apart,
+         * whose heights differ by rounding (up to 6e-14 m) after two frames:
+         * once counted as crossing (the line where their planes meet, 1e-9
+         * rad apart, was placed by noise). Coordinates as the simulation
+         * left them. */
+        const double p[3][3] = {{-0.21270064137919761, -0.22854424084076114, 0.27606305938876485},
+                                {-0.19688030757707123, -0.22852300966400393, 0.27606305938876485},
+                                {-0.19680961672624633, -0.21264994423975106, 0.27606305938882342}};
+        const double q[3][3] = {{-0.22854345406938401, -0.21270032952265452, 0.27606305938876485},
+                                {-0.2126728895191661, -0.21267313359475115, 0.2760630593888001},
+                                {-0.21264858374375845, -0.19681061248855206, 0.2760630593888187}};
+        expect_pair(p, q, 0, "noisy flat sheet, half a cell apart");
+        /* A real crossing at a small angle (1e-4 rad) is still one. */
+        const double a[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+        const double b[3][3] = {{0.2, 0.2, -1e-4}, {0.8, 0.2, 1e-4}, {0.2, 0.6, -1e-4}};
+        expect_pair(a, b, 1, "crossing at 1e-4 rad");
+    }
 }
 
 /* Random pairs built to cross must be found, the same pairs lifted clear of
