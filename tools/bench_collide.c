@@ -13,8 +13,9 @@
  * The thesis drew one frame per step, so its fps compares with our
  * steps per second.
  *
- * Self-collision, larger cloths: n x n cloths dropped onto the sphere with
- * self-collision on; particle-steps per second.
+ * Self-collision, larger cloths: n x n cloths starting 1 cm above the
+ * sphere (so in contact from the start at every size), self-collision on,
+ * 2 frames; particle-steps per second.
  *
  * Cost per particle-step against size: n x n cloths of the same link
  * length (1/63 m, so the same stable step at every size) lying on a ground
@@ -80,7 +81,9 @@ typedef struct result {
     int32_t intersections;
 } result;
 
-static result run(int size, int self_collision, int threads, double seconds)
+/* The Table 3.2 scene: the cloth starts `height` m above the sphere's
+ * centre (0.6 in the thesis; the larger cloths start on the sphere). */
+static result run_from(int size, int self_collision, int threads, double seconds, double height)
 {
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
@@ -90,11 +93,11 @@ static result run(int size, int self_collision, int threads, double seconds)
     add_sphere(w);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = size;
-    g.center[2] = 0.6;
+    g.center[2] = height;
     g.self_collision = self_collision;
     int32_t c;
     check(wc_world_add_grid_cloth(w, &g, &c), w, "add cloth");
-    int frames = (int)ceil(seconds * 24.0);
+    int frames = (int)ceil(seconds * 24.0 - 1e-9);
     result r = {0, 0, 0, 0};
     double t0 = now();
     for (int f = 0; f < frames; ++f) {
@@ -109,6 +112,11 @@ static result run(int size, int self_collision, int threads, double seconds)
     r.particle_steps_per_second = r.steps_per_second * size * size;
     wc_world_destroy(w);
     return r;
+}
+
+static result run(int size, int self_collision, int threads, double seconds)
+{
+    return run_from(size, self_collision, threads, seconds, 0.6);
 }
 
 static void add_ground(wc_world *w, double half)
@@ -185,11 +193,13 @@ int main(int argc, char **argv)
             printf("| %d | %s | %.0f | %d | %.0fx | %d |\n", sizes[i] * sizes[i], self ? "on" : "off",
                    r.steps_per_second, thesis, r.steps_per_second / thesis, (int)r.intersections);
         }
-    printf("\nSelf-collision on, larger cloths (same scene):\n\n");
+    printf("\nSelf-collision on, larger cloths, starting 1 cm above the sphere, 2 frames:\n\n");
     printf("| particles | particle-steps/s | steps/s | intersections at end |\n|---|---|---|---|\n");
     static const int big[3] = {64, 128, 256};
     for (int i = 0; i < 3; ++i) {
-        result r = run(big[i], 1, threads, i == 2 ? seconds / 8 : seconds / 2);
+        /* 1 cm above the top of the sphere: in contact from the start, so
+         * every size is timed while draping, for 2 frames */
+        result r = run_from(big[i], 1, threads, 2.0 / 24.0, 0.31);
         printf("| %d | %.2f M | %.0f | %d |\n", big[i] * big[i], r.particle_steps_per_second / 1e6,
                r.steps_per_second, (int)r.intersections);
     }
