@@ -188,3 +188,26 @@ def test_pc2_round_trip(tmp_path):
     short.write(frames[0])
     with pytest.raises(RuntimeError, match="wrote 1 frames, the header says 3"):
         short.close()
+
+
+# Found by fuzzing the loader (tests/fuzz/fuzz_scene.py): each of these raised
+# something other than SceneError.
+@pytest.mark.parametrize("text,message", [
+    # json.loads refuses integers of more than 4300 digits with ValueError
+    ('{"duration": ' + "9" * 5000 + "}", "invalid JSON: Exceeds the limit"),
+    # and deep nesting with RecursionError
+    ("[" * 100000, "invalid JSON: nested too deeply"),
+    # an integer that float() cannot hold raised OverflowError
+    ('{"gravity": [0, 0, 1' + "0" * 400 + '], "cloths": [{"grid": {"nu": 2, "nv": 2}}]}',
+     "gravity[2]: expected a finite number, found a 1329-bit integer, too large for a double"),
+    # a NUL in an OBJ path raised ValueError from open()
+    ('{"cloths": [{"obj": "a\\u0000.obj"}]}', "cloths[0].obj: cannot read"),
+    # a device would be read forever
+    ('{"cloths": [{"obj": "/dev/zero"}]}', "cloths[0].obj: cannot read /dev/zero: not a regular file"),
+])
+def test_loader_raises_only_scene_error(tmp_path, text, message):
+    p = tmp_path / "s.json"
+    p.write_text(text)
+    with pytest.raises(scene.SceneError) as e:
+        scene.load(str(p))
+    assert message in str(e.value)

@@ -5,6 +5,7 @@ MeshError naming the file and the line.
 """
 
 import os
+import stat
 import struct
 
 import numpy as np
@@ -22,8 +23,11 @@ def read_obj(path):
     are ignored."""
     try:
         with open(path, encoding="utf-8") as f:
+            # a device (/dev/zero) or a pipe would be read forever
+            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                raise MeshError("cannot read %s: not a regular file" % path)
             lines = f.read().splitlines()
-    except (OSError, UnicodeDecodeError) as e:
+    except (OSError, UnicodeDecodeError, ValueError) as e:  # ValueError: a NUL in the path
         raise MeshError("cannot read %s: %s" % (path, getattr(e, "strerror", None) or e)) from None
     vertices, faces, face_lines = [], [], []
     for number, line in enumerate(lines, 1):

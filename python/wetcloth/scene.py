@@ -45,6 +45,9 @@ def _type_name(value):
         return "null"
     if isinstance(value, bool):
         return "a boolean (%s)" % json.dumps(value)
+    if isinstance(value, int) and value.bit_length() > 64:
+        # Python refuses to print integers past 4300 digits
+        return "a %d-bit integer" % value.bit_length()
     if isinstance(value, (int, float)):
         return "the number %s" % json.dumps(value)
     if isinstance(value, str):
@@ -145,7 +148,10 @@ class _Reader:
 def check_number(fail, key, v, minimum=None, maximum=None, above=None):
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         fail(key, "expected a number, found %s" % _type_name(v))
-    v = float(v)
+    try:
+        v = float(v)
+    except OverflowError:
+        fail(key, "expected a finite number, found %s, too large for a double" % _type_name(v))
     if not math.isfinite(v):
         fail(key, "expected a finite number, found %r" % v)
     if above is not None and not v > above:
@@ -243,6 +249,10 @@ def load(path):
     except json.JSONDecodeError as e:
         raise SceneError("%s:%d:%d" % (path, e.lineno, e.colno), "",
                          "invalid JSON: %s" % e.msg) from None
+    except ValueError as e:  # an integer of more than 4300 digits
+        raise SceneError(path, "", "invalid JSON: %s" % e) from None
+    except RecursionError:
+        raise SceneError(path, "", "invalid JSON: nested too deeply") from None
     return from_dict(data, path, os.path.dirname(os.path.abspath(path)))
 
 
