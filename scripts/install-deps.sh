@@ -17,8 +17,33 @@ for p in "${packages[@]}"; do
     fi
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
+# Optional, for the robustness tests (docs/robustness.md): clang with its
+# libFuzzer/sanitizer runtimes (the fuzz_api test; the build itself stays
+# gcc) and valgrind (the memcheck_scene test). Installed when the
+# distribution has them (Debian bookworm does); without them those two tests
+# are not registered, and nothing else changes.
+optional=(clang libclang-rt-14-dev valgrind)
+optional_missing=()
+for p in "${optional[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+        optional_missing+=("$p")
+    fi
+done
+
+install_optional() {
+    [ ${#optional_missing[@]} -eq 0 ] && return 0
+    echo "install-deps: installing the optional ${optional_missing[*]}"
+    "${sudo[@]}" apt-get install -y -q --no-install-recommends "${optional_missing[@]}" ||
+        echo "install-deps: could not install ${optional_missing[*]}; the fuzz and memcheck tests will not run" >&2
+}
+
+if [ ${#missing[@]} -eq 0 ] && [ ${#optional_missing[@]} -eq 0 ]; then
     echo "install-deps: all packages present (${packages[*]})"
+    exit 0
+fi
+
+if [ ${#missing[@]} -eq 0 ] && ! command -v apt-get >/dev/null 2>&1; then
+    echo "install-deps: all required packages present; optional ${optional_missing[*]} missing (no apt-get)"
     exit 0
 fi
 
@@ -34,13 +59,20 @@ if [ "$(id -u)" -ne 0 ]; then
     if command -v sudo >/dev/null 2>&1; then
         sudo=(sudo)
     else
+        if [ ${#missing[@]} -eq 0 ]; then
+            echo "install-deps: all required packages present; optional ${optional_missing[*]} missing (not root, no sudo)"
+            exit 0
+        fi
         echo "install-deps: missing ${missing[*]}; not root and no sudo." >&2
         echo "As root run: apt-get update && apt-get install -y ${missing[*]}" >&2
         exit 1
     fi
 fi
 
-echo "install-deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 "${sudo[@]}" apt-get update -q
-"${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "install-deps: installing ${missing[*]}"
+    "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+install_optional
