@@ -107,8 +107,77 @@ static void wicking_tiny_link(double side)
     wc_world_destroy(w);
 }
 
+/* Mesh colliders and moving colliders: each bad argument gets its status
+ * and a message naming the problem, and adds or moves nothing. */
+static void expect(wc_world *w, wc_status got, wc_status want, const char *call, const char *needle)
+{
+    CHECK(got == want, "%s: status %s, expected %s", call, wc_status_name(got), wc_status_name(want));
+    const char *m = wc_world_last_error(w);
+    CHECK(m[0] != '\0' && strstr(m, needle), "%s: message \"%s\" should name \"%s\"", call, m, needle);
+}
+
+static void collider_bad_input(void)
+{
+    wc_world *w = world();
+    double v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    int32_t t[3] = {0, 1, 2};
+    wc_mesh_collider_def good = wc_mesh_collider_def_default();
+    good.vertices = v;
+    good.vertex_count = 3;
+    good.triangles = t;
+    good.triangle_count = 1;
+    int32_t id = -1;
+    wc_mesh_collider_def d = good;
+    d.vertex_count = 2;
+    expect(w, wc_world_add_mesh_collider(w, &d, &id), WC_ERROR_INVALID_ARGUMENT, "2 vertices", "vertex_count");
+    d = good;
+    d.triangle_count = 0;
+    expect(w, wc_world_add_mesh_collider(w, &d, &id), WC_ERROR_INVALID_ARGUMENT, "0 triangles", "triangle_count");
+    d = good;
+    d.vertices = NULL;
+    expect(w, wc_world_add_mesh_collider(w, &d, &id), WC_ERROR_INVALID_ARGUMENT, "NULL vertices", "vertices");
+    expect(w, wc_world_add_mesh_collider(w, NULL, &id), WC_ERROR_INVALID_ARGUMENT, "NULL def", "def");
+    expect(w, wc_world_add_mesh_collider(w, &good, NULL), WC_ERROR_INVALID_ARGUMENT, "NULL out", "out_collider");
+    double vn[9] = {0, 0, 0, 1, 0, 0, 0, NAN, 0};
+    d = good;
+    d.vertices = vn;
+    expect(w, wc_world_add_mesh_collider(w, &d, &id), WC_ERROR_INVALID_ARGUMENT, "NaN vertex", "vertex 2");
+    int32_t tb[3] = {0, 1, 3}, tn[3] = {0, -1, 2};
+    d = good;
+    d.triangles = tb;
+    expect(w, wc_world_add_mesh_collider(w, &d, &id), WC_ERROR_INVALID_ARGUMENT, "index 3", "uses vertex 3");
+    d.triangles = tn;
+    expect(w, wc_world_add_mesh_collider(w, &d, &id), WC_ERROR_INVALID_ARGUMENT, "index -1", "uses vertex -1");
+    d = good;
+    d.thickness = -1.0;
+    expect(w, wc_world_add_mesh_collider(w, &d, &id), WC_ERROR_INVALID_ARGUMENT, "thickness", "thickness");
+    d = good;
+    d.friction = NAN;
+    expect(w, wc_world_add_mesh_collider(w, &d, &id), WC_ERROR_INVALID_ARGUMENT, "friction", "friction");
+    CHECK(wc_world_collider_count(w) == 0 && id == -1, "a refused collider was added");
+
+    int32_t mesh, sphere;
+    CHECK(wc_world_add_mesh_collider(w, &good, &mesh) == WC_OK, "good mesh: %s", wc_world_last_error(w));
+    wc_convex_collider_def c = wc_convex_collider_def_default();
+    CHECK(wc_world_add_convex_collider(w, &c, &sphere) == WC_OK, "sphere: %s", wc_world_last_error(w));
+    double moved[9] = {0, 0, 1, 1, 0, 1, 0, 1, NAN};
+    expect(w, wc_collider_set_vertices(w, mesh, moved, 2), WC_ERROR_INVALID_ARGUMENT, "2 of 3 vertices", "3");
+    expect(w, wc_collider_set_vertices(w, mesh, NULL, 3), WC_ERROR_INVALID_ARGUMENT, "NULL vertices", "NULL");
+    expect(w, wc_collider_set_vertices(w, mesh, moved, 3), WC_ERROR_INVALID_ARGUMENT, "NaN vertex", "finite");
+    expect(w, wc_collider_set_vertices(w, 7, moved, 3), WC_ERROR_NOT_FOUND, "collider 7", "7");
+    expect(w, wc_collider_set_vertices(w, -1, moved, 3), WC_ERROR_NOT_FOUND, "collider -1", "-1");
+    double pos[3] = {0, 0, 0}, rot[4] = {1, 0, 0, 0}, zero[4] = {0, 0, 0, 0}, nan3[3] = {0, NAN, 0};
+    expect(w, wc_collider_set_transform(w, sphere, nan3, rot), WC_ERROR_INVALID_ARGUMENT, "NaN position", "position");
+    expect(w, wc_collider_set_transform(w, sphere, pos, zero), WC_ERROR_INVALID_ARGUMENT, "zero quaternion", "rotation");
+    expect(w, wc_collider_set_transform(w, sphere, NULL, rot), WC_ERROR_INVALID_ARGUMENT, "NULL position", "NULL");
+    expect(w, wc_collider_set_transform(w, 9, pos, rot), WC_ERROR_NOT_FOUND, "collider 9", "9");
+    CHECK(wc_world_collider_count(w) == 2, "collider count changed");
+    wc_world_destroy(w);
+}
+
 int main(void)
 {
+    collider_bad_input();
     pin_targets_without_pins();
     grid_awkward_boxes();
     wicking_tiny_link(1e-6);
