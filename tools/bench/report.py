@@ -21,7 +21,8 @@ none is edited by hand):
 4. Blender side by side (tools/bench/blender_side.py, run under the Python
    that has bpy, .venv-blender): Blender's cloth (quality 5) and ours on
    the grid cloth onto the 114-vertex sphere.
-5. the thesis' Table 3.2 next to ours (the output of bench_collide).
+5. the thesis' Table 3.2 next to ours (the output of bench_collide);
+6. (full mode) the hard cases: the output of tests/test_hard_cases.
 
 Environment: the wetcloth package must be importable (PYTHONPATH=<build>/python,
 the staged package of a build, or an installed one); --bench-collide names
@@ -136,10 +137,10 @@ def speed_vs_error(out, quick, lines):
                              f"{r['error']:.2e} | {r['cost']:.3g} | {note} |")
         fig, ax = plt.subplots(figsize=(6, 4.2))
         for integ, mark in zip(INTEGRATORS, "os^"):
-            pts = [(r["cost"], r["error"]) for r in rows
+            pts = [(r["substeps"], r["cost"], r["error"]) for r in rows
                    if r["integrator"] == integ and r["failed"] is None]
-            if pts:
-                x, y = zip(*sorted(pts))
+            if pts:  # joined in order of the step, so measurement noise shows as such
+                _, x, y = zip(*sorted(pts))
                 ax.plot(x, [max(v, 1e-12) for v in y], mark + "-", label=integ)
         d = [r for r in rows if r["default"] and r["failed"] is None]
         if d:
@@ -388,14 +389,29 @@ def table_3_2(program, quick, lines):
         lines += r.stdout.rstrip().splitlines() + [""]
 
 
+def hard_cases(program, lines):
+    lines += ["## Hard cases", "",
+              "tests/test_hard_cases.c (a ctest test; each case with its pass criterion: finite, a "
+              "failed step keeps the last state, energy bounded, 0 intersections by the checker, "
+              "bitwise the same with 1 and 2 threads). Its output in this run:", ""]
+    if not program or not os.path.exists(program):
+        lines += [f"Skipped: no test_hard_cases program ({program}).", ""]
+        return None
+    env = dict(os.environ, OMP_WAIT_POLICY="passive")
+    r = subprocess.run([program], capture_output=True, text=True, env=env)
+    lines += ["```"] + (r.stdout + r.stderr).rstrip().splitlines() + ["```", ""]
+    return r.returncode
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", required=True, help="folder for report.md, the PNGs and results.json")
     ap.add_argument("--quick", action="store_true", help="small sizes, a smoke test (< 60 s)")
     ap.add_argument("--bench-collide", default=os.path.join(ROOT, "build", "tools", "bench_collide"))
+    ap.add_argument("--hard-cases", default=os.path.join(ROOT, "build", "tests", "test_hard_cases"))
     ap.add_argument("--blender-python", default=os.path.join(ROOT, ".venv-blender", "bin", "python"))
     ap.add_argument("--skip", default="", help="comma-separated sections to skip: "
-                    "speed,closed,scaling,blender,table")
+                    "speed,closed,scaling,blender,table,hard")
     a = ap.parse_args()
     skip = set(filter(None, a.skip.split(",")))
     os.makedirs(a.out, exist_ok=True)
@@ -426,6 +442,8 @@ def main():
         results["blender"] = blender(a.out, a.quick, a.blender_python, lines)
     if "table" not in skip:
         table_3_2(a.bench_collide, a.quick, lines)
+    if "hard" not in skip and not a.quick:
+        results["hard_cases_exit_code"] = hard_cases(a.hard_cases, lines)
     # Sanity checks, so that the smoke test can fail (tolerances argued in
     # tests/test_integration.c and docs/model.md): free fall exact to
     # rounding for Verlet and XPBD; the spring period within 0.1 %; the
@@ -450,6 +468,8 @@ def main():
         d = [row for row in r["rows"] if row["default"]]
         if not d or d[0]["failed"] or not d[0]["error"] <= 1e-3:
             failures.append(f"{name}: the default setting's error is not below 1e-3: {d}")
+    if results.get("hard_cases_exit_code"):
+        failures.append("test_hard_cases failed")
     for row in results.get("blender") or []:
         k = row["ours_intersections"]
         if k["cloth_cloth"] or k["cloth_collider"]:
