@@ -1316,6 +1316,19 @@ static void evaluate(wc_self_state *s, const self_ctx *ctx, int ccd_only, int th
 /* Answers one contact against the current state: moves nx (and q for the
  * part that must not become velocity), marks contacts. Returns whether any
  * particle moved. */
+/* Wetness of a pair in sustained contact: each side's wetness at the
+ * contact point (barycentric over its particles that touched something in
+ * the last step), the two sides averaged. 0 for dry cloth. */
+static double sustained_wetness(const wc_cloth *c, const self_contact *k)
+{
+    double wet = 0.0;
+    for (int j = 0; j < 4; ++j) {
+        int32_t i = k->p[j];
+        if (c->contact_prev[i] != WC_CONTACT_NONE) wet += 0.5 * fabs(k->w[j]) * c->wetness[i];
+    }
+    return wet;
+}
+
 static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double mu, double slack,
                    int32_t *marked)
 {
@@ -1374,15 +1387,17 @@ static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double 
     if (dv == 0.0 && dp <= 0.0) return 0;
     /* Coulomb friction on the relative tangential motion: its change is at
      * most mu times the normal change (tangential part of du is unchanged by
-     * the normal impulse). */
-    double ft[3] = {0.0, 0.0, 0.0};
-    if (dv > 0.0 && mu > 0.0) {
+     * the normal impulse). Wet layers in sustained contact also lose the
+     * share 1 - q of what Coulomb leaves (thesis eq. 2.10, as on colliders). */
+    double ft[3] = {0.0, 0.0, 0.0}, wet = c->wet_forces ? sustained_wetness(c, k) : 0.0;
+    if (dv > 0.0 && (mu > 0.0 || wet > 0.0)) {
         double vt[3];
         for (int m = 0; m < 3; ++m) vt[m] = du[m] - un * k->n[m];
         double len = sqrt(dot3(vt, vt));
         if (len > 0.0) {
             double f = mu * dv / len;
             if (f > 1.0) f = 1.0;
+            if (wet > 0.0) f = 1.0 - (1.0 - f) * (1.0 - wet * (1.0 - c->material.wet_friction));
             for (int m = 0; m < 3; ++m) ft[m] = -f * vt[m];
         }
     }
