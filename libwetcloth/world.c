@@ -87,6 +87,7 @@ void wc_world_destroy(wc_world *w)
     for (int32_t i = 0; i < w->collider_count; ++i) wc_collider_destroy(w->colliders[i]);
     wc_free(w->cloths);
     wc_free(w->colliders);
+    wc_contact_backup_free(&w->backup);
     wc_free(w);
 }
 
@@ -231,8 +232,17 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
     t1 = wc_clock_seconds(), phase[1] += t1 - t0, t0 = t1;
     int colliding = w->collider_count > 0 || any_self_collision(w);
     if (colliding) {
+        /* collision changes contacts before it knows it will succeed: a
+         * failed step puts them back (contact_backup.h) */
+        if (wc_contact_backup_save(&w->backup, w->cloths, w->cloth_count))
+            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                           "out of memory saving the contact state; the world keeps its last "
+                           "good state");
         wc_status s = collide(w, dt, share, threads);
-        if (s) return s;
+        if (s) {
+            wc_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
+            return s;
+        }
     }
     t1 = wc_clock_seconds(), phase[2] += t1 - t0, t0 = t1;
     if (colliding)

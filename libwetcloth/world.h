@@ -3,6 +3,7 @@
 
 #include "cloth.h"
 #include "collider.h"
+#include "contact_backup.h"
 #include "wetcloth.h"
 
 struct wc_world {
@@ -24,6 +25,8 @@ struct wc_world {
     /// report here: the world itself is never const-defined (it comes from
     /// wc_world_create), so writing through a cast pointer is well defined.
     wc_message error;
+    /// Contact state saved before each step's collision (contact_backup.h).
+    wc_contact_backup backup;
 };
 
 /// The world's message buffer, writable from const entry points.
