@@ -7,6 +7,9 @@
  * degenerate and duplicate faces. Running out of bytes reads zeros, which
  * decode to sensible defaults, so short inputs make valid scenes.
  *
+ * With bit 128 of the first byte set, one allocation (its number taken from
+ * the input) fails, through wc_set_allocator.
+ *
  * It aborts (a crash libFuzzer reports) when a call fails with an empty
  * message or an unknown status, or when a step or advance returns WC_OK and
  * leaves a non-finite position. The sanitizers (address, undefined) catch
@@ -106,6 +109,25 @@ static int32_t index_in(reader *r, int32_t n)
     if (kind == 254) return -1;
     if (kind == 253) return n;
     return n > 0 ? (int32_t)(kind % (uint32_t)n) : 0;
+}
+
+/* Allocation failure: with bit 128 of the first byte set, allocation
+ * number g_fail_at (from the input) returns NULL; the calls must then fail
+ * with WC_ERROR_OUT_OF_MEMORY and a message, and leak nothing (AddressSanitizer's
+ * leak check runs after each input). */
+static long g_allocs, g_fail_at = -1;
+
+static void *fuzz_alloc(size_t size, void *user)
+{
+    (void)user;
+    if (g_allocs++ == g_fail_at) return NULL;
+    return malloc(size);
+}
+
+static void fuzz_free(void *memory, void *user)
+{
+    (void)user;
+    free(memory);
 }
 
 static void fail(const char *what, const char *detail)
@@ -460,6 +482,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (odd & 8) def.substep_safety = num(&r, 0.9);
     if (odd & 16) def.max_substeps = count(&r, 64);
     if (def.thread_count > 2 && def.thread_count <= 1024) def.thread_count = 2;
+    g_allocs = 0;
+    g_fail_at = -1;
+    if (odd & 128) {
+        g_fail_at = (long)u8(&r) + 256L * (long)(u8(&r) & 3);
+        wc_set_allocator(fuzz_alloc, fuzz_free, NULL);
+    }
     wc_world *w = NULL;
     wc_message msg;
     memset(&msg, 0, sizeof msg);
@@ -467,6 +495,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (s != WC_OK) {
         if (w) fail("wc_world_create", "failed but gave a world");
         if (!msg.text[0]) fail("wc_world_create", "failed with an empty message");
+        wc_set_allocator(NULL, NULL, NULL);
         return 0;
     }
     /* automatic substepping only where the world caps it low */
@@ -489,6 +518,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* and a step after the last accepted input */
     if (wc_world_step(w, 2e-4) == WC_OK) check_finite(w, "final wc_world_step");
     wc_world_destroy(w);
+    wc_set_allocator(NULL, NULL, NULL);
     return 0;
 }
 
