@@ -32,9 +32,8 @@ trap 'rm -f "$tmp"' EXIT
   echo "\`test_hard_cases\`' own output): a forced Verlet step well above \`wc_world_stable_dt\` is not"
   echo "refused: the cloth explodes over tens of steps while every step returns \`WC_OK\`, and the step"
   echo "that finally overflows fails with \`WC_ERROR_NON_FINITE\` keeping an exploded \"last good\" state;"
-  echo "a self-colliding cloth can show a few cloth-cloth intersections for single frames (sharp"
-  echo "one-link creases at the start of a sag or on landing) that are gone a frame later; separate"
-  echo "cloths do not collide with each other; XPBD's single iteration leaves stretch short of"
+  echo "separate cloths do not collide with each other (one mesh of several pieces with self-collision"
+  echo "does); XPBD's single iteration leaves stretch short of"
   echo "converged at the automatic substeps (a cloth swinging from two corners stretches further than"
   echo "under Verlet), which the speed-against-error tables show as its error."
   echo
