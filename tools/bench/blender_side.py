@@ -110,8 +110,11 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--json")
+    ap.add_argument("--sizes", default="10,15,20,51,101",
+                    help="grid sizes n of the full run (48 frames up to 20, else 24)")
     a = ap.parse_args()
-    cases = [(10, 12)] if a.quick else [(10, 48), (15, 48), (20, 48), (51, 24), (101, 24)]
+    cases = [(10, 12)] if a.quick else [(n, 48 if n <= 20 else 24)
+                                        for n in map(int, a.sizes.split(","))]
     print(f"bpy {bpy.app.version_string}, libwetcloth {wetcloth.__version__}; load average "
           f"before: {' '.join(open('/proc/loadavg').read().split()[:3])}.")
     print()

@@ -338,7 +338,7 @@ def scaling(out, quick, lines):
 # 4. Blender and 5. Table 3.2
 # ---------------------------------------------------------------------------
 
-def blender(out, quick, python, lines):
+def blender(out, quick, python, lines, sizes=None):
     lines += ["## Side by side with Blender", ""]
     if not python or not os.path.exists(python):
         lines += [f"Skipped: no Python with bpy ({python}).", ""]
@@ -359,6 +359,8 @@ def blender(out, quick, python, lines):
     cmd = [python, os.path.join(HERE, "blender_side.py"), "--json", os.path.join(out, "blender.json")]
     if quick:
         cmd.append("--quick")
+    elif sizes:
+        cmd += ["--sizes", sizes]
     try:
         r = subprocess.run(cmd, env=env, capture_output=True, text=True)
     finally:
@@ -410,6 +412,8 @@ def main():
     ap.add_argument("--bench-collide", default=os.path.join(ROOT, "build", "tools", "bench_collide"))
     ap.add_argument("--hard-cases", default=os.path.join(ROOT, "build", "tests", "test_hard_cases"))
     ap.add_argument("--blender-python", default=os.path.join(ROOT, ".venv-blender", "bin", "python"))
+    ap.add_argument("--blender-sizes", default="10,15,20,51,101",
+                    help="grid sizes n of Blender's side (full mode)")
     ap.add_argument("--only", default="", help="comma-separated sections to run (the others' "
                     "parts already in --out are kept)")
     ap.add_argument("--skip", default="", help="comma-separated sections to skip: "
@@ -442,7 +446,7 @@ def main():
         ("speed", lambda L: speed_vs_error(a.out, a.quick, L)),
         ("closed", lambda L: closed_form(L)),
         ("scaling", lambda L: scaling(a.out, a.quick, L)),
-        ("blender", lambda L: blender(a.out, a.quick, a.blender_python, L)),
+        ("blender", lambda L: blender(a.out, a.quick, a.blender_python, L, a.blender_sizes)),
         ("table", lambda L: table_3_2(a.bench_collide, a.quick, L)),
         ("hard", lambda L: hard_cases(a.hard_cases, L) if not a.quick else None),
     ]
