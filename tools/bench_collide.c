@@ -29,50 +29,9 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "wetcloth.h"
 
-#define PI 3.14159265358979323846
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static void check(wc_status s, const wc_world *w, const char *what)
-{
-    if (s == WC_OK) return;
-    fprintf(stderr, "%s failed: %s: %s\n", what, wc_status_name(s), w ? wc_world_last_error(w) : "");
-    exit(1);
-}
-
-static void add_sphere(wc_world *w)
-{
-    double v[3 * 114];
-    int32_t t[3 * 224], n = 0, k = 0, seg = 16, rings = 8, col;
-    v[0] = v[1] = 0.0, v[2] = 0.3, n = 1;
-    for (int32_t j = 1; j < rings; ++j)
-        for (int32_t i = 0; i < seg; ++i, ++n) {
-            double polar = PI * j / rings, az = 2.0 * PI * i / seg;
-            v[3 * n] = 0.3 * sin(polar) * cos(az);
-            v[3 * n + 1] = 0.3 * sin(polar) * sin(az);
-            v[3 * n + 2] = 0.3 * cos(polar);
-        }
-    v[3 * n] = v[3 * n + 1] = 0.0, v[3 * n + 2] = -0.3;
-    int32_t bottom = n++, base = 1 + (rings - 2) * seg;
-    for (int32_t i = 0; i < seg; ++i) t[k++] = 0, t[k++] = 1 + i, t[k++] = 1 + (i + 1) % seg;
-    for (int32_t j = 0; j + 2 < rings; ++j)
-        for (int32_t i = 0; i < seg; ++i) {
-            int32_t a = 1 + j * seg + i, b = 1 + j * seg + (i + 1) % seg;
-            t[k++] = a, t[k++] = a + seg, t[k++] = b;
-            t[k++] = b, t[k++] = a + seg, t[k++] = b + seg;
-        }
-    for (int32_t i = 0; i < seg; ++i) t[k++] = bottom, t[k++] = base + (i + 1) % seg, t[k++] = base + i;
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertices = v, d.vertex_count = n, d.triangles = t, d.triangle_count = k / 3;
-    check(wc_world_add_mesh_collider(w, &d, &col), w, "add sphere");
-}
 
 typedef struct result {
     double steps_per_second;
@@ -89,24 +48,24 @@ static result run_from(int size, int self_collision, int threads, double seconds
     wd.thread_count = threads;
     wc_world *w;
     wc_message m;
-    check(wc_world_create(&wd, &w, &m), NULL, m.text);
-    add_sphere(w);
+    bench_check(wc_world_create(&wd, &w, &m), NULL, m.text);
+    bench_add_thesis_sphere(w);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = size;
     g.center[2] = height;
     g.self_collision = self_collision;
     int32_t c;
-    check(wc_world_add_grid_cloth(w, &g, &c), w, "add cloth");
+    bench_check(wc_world_add_grid_cloth(w, &g, &c), w, "add cloth");
     int frames = (int)ceil(seconds * 24.0 - 1e-9);
     result r = {0, 0, 0, 0};
-    double t0 = now();
+    double t0 = bench_now();
     for (int f = 0; f < frames; ++f) {
-        check(wc_world_advance(w, 1.0 / 24.0, 0), w, "advance");
+        bench_check(wc_world_advance(w, 1.0 / 24.0, 0), w, "advance");
         r.steps += wc_world_last_substeps(w);
     }
-    double wall = now() - t0;
+    double wall = bench_now() - t0;
     wc_intersection_counts counts;
-    check(wc_world_count_intersections(w, &counts), w, "count_intersections");
+    bench_check(wc_world_count_intersections(w, &counts), w, "count_intersections");
     r.intersections = counts.cloth_cloth + counts.cloth_collider;
     r.steps_per_second = (double)r.steps / wall;
     r.particle_steps_per_second = r.steps_per_second * size * size;
@@ -125,7 +84,7 @@ static void add_ground(wc_world *w, double half)
     int32_t t[6] = {0, 1, 2, 0, 2, 3}, col;
     wc_mesh_collider_def d = wc_mesh_collider_def_default();
     d.vertices = v, d.vertex_count = 4, d.triangles = t, d.triangle_count = 2;
-    check(wc_world_add_mesh_collider(w, &d, &col), w, "add ground");
+    bench_check(wc_world_add_mesh_collider(w, &d, &col), w, "add ground");
 }
 
 /* Particle-steps per second of an n x n cloth resting on the ground. */
@@ -135,7 +94,7 @@ static double resting(int size, int self_collision, int threads)
     wd.thread_count = threads;
     wc_world *w;
     wc_message m;
-    check(wc_world_create(&wd, &w, &m), NULL, m.text);
+    bench_check(wc_world_create(&wd, &w, &m), NULL, m.text);
     double width = (size - 1) / 63.0;
     add_ground(w, width);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
@@ -144,12 +103,12 @@ static double resting(int size, int self_collision, int threads)
     g.center[2] = g.material.thickness * 1.01;
     g.self_collision = self_collision;
     int32_t c;
-    check(wc_world_add_grid_cloth(w, &g, &c), w, "add cloth");
+    bench_check(wc_world_add_grid_cloth(w, &g, &c), w, "add cloth");
     double dt = wc_world_stable_dt(w);
-    for (int k = 0; k < 20; ++k) check(wc_world_step(w, dt), w, "step");
-    double t0 = now();
-    for (int k = 0; k < 100; ++k) check(wc_world_step(w, dt), w, "step");
-    double rate = 100.0 * size * size / (now() - t0);
+    for (int k = 0; k < 20; ++k) bench_check(wc_world_step(w, dt), w, "step");
+    double t0 = bench_now();
+    for (int k = 0; k < 100; ++k) bench_check(wc_world_step(w, dt), w, "step");
+    double rate = 100.0 * size * size / (bench_now() - t0);
     if (wc_world_get_stats(w).collider_contacts < size * size / 2) {
         fprintf(stderr, "resting %dx%d: the cloth is not on the ground\n", size, size);
         exit(1);

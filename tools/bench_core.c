@@ -13,14 +13,8 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "wetcloth.h"
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static double uniform(void)
@@ -31,13 +25,6 @@ static double uniform(void)
     return (double)(rng_state >> 11) / 9007199254740992.0;
 }
 
-static void check(wc_status s, const wc_world *w, const char *what)
-{
-    if (s == WC_OK) return;
-    fprintf(stderr, "%s failed: %s: %s\n", what, wc_status_name(s), w ? wc_world_last_error(w) : "");
-    exit(1);
-}
-
 /* Seconds for `steps` steps of a size x size crumpled cloth on `threads`. */
 static double run(int size, int steps, int threads, double *stable_dt, int32_t *bend_links)
 {
@@ -45,14 +32,14 @@ static double run(int size, int steps, int threads, double *stable_dt, int32_t *
     wd.thread_count = threads;
     wc_world *w;
     wc_message m;
-    check(wc_world_create(&wd, &w, &m), NULL, m.text);
+    bench_check(wc_world_create(&wd, &w, &m), NULL, m.text);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = size;
     int32_t c;
-    check(wc_world_add_grid_cloth(w, &g, &c), w, "add_grid_cloth");
+    bench_check(wc_world_add_grid_cloth(w, &g, &c), w, "add_grid_cloth");
     int32_t n = wc_cloth_particle_count(w, c);
     double *xyz = malloc(3 * sizeof(double) * (size_t)n);
-    check(wc_cloth_get_positions(w, c, xyz, n), w, "get_positions");
+    bench_check(wc_cloth_get_positions(w, c, xyz, n), w, "get_positions");
     double h = 1.0 / (size - 1);
     rng_state = 0x9E3779B97F4A7C15ull;
     for (int32_t i = 0; i < n; ++i) {
@@ -60,15 +47,15 @@ static double run(int size, int steps, int threads, double *stable_dt, int32_t *
         xyz[3 * i + 1] *= 0.7;
         xyz[3 * i + 2] = 0.3 * h * (uniform() - 0.5);
     }
-    check(wc_cloth_set_positions(w, c, xyz, n), w, "set_positions");
+    bench_check(wc_cloth_set_positions(w, c, xyz, n), w, "set_positions");
     free(xyz);
     *stable_dt = wc_world_stable_dt(w);
     *bend_links = wc_cloth_link_count(w, c, WC_LINK_BEND);
     double dt = 0.9 * *stable_dt;
-    check(wc_world_step(w, dt), w, "warm-up step");
-    double t0 = now();
-    for (int s = 0; s < steps; ++s) check(wc_world_step(w, dt), w, "step");
-    double t1 = now();
+    bench_check(wc_world_step(w, dt), w, "warm-up step");
+    double t0 = bench_now();
+    for (int s = 0; s < steps; ++s) bench_check(wc_world_step(w, dt), w, "step");
+    double t1 = bench_now();
     wc_world_destroy(w);
     return t1 - t0;
 }

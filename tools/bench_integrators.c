@@ -22,51 +22,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "wetcloth.h"
 
-#define PI 3.14159265358979323846
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static void check(wc_status s, const wc_world *w, const char *what)
-{
-    if (s == WC_OK) return;
-    fprintf(stderr, "%s failed: %s: %s\n", what, wc_status_name(s), w ? wc_world_last_error(w) : "");
-    exit(1);
-}
-
-/* The thesis' solid: UV sphere, 16 segments x 8 rings = 114 vertices. */
-static void add_sphere(wc_world *w)
-{
-    double v[3 * 114];
-    int32_t t[3 * 224], n = 0, k = 0, seg = 16, rings = 8, col;
-    v[0] = v[1] = 0.0, v[2] = 0.3, n = 1;
-    for (int32_t j = 1; j < rings; ++j)
-        for (int32_t i = 0; i < seg; ++i, ++n) {
-            double polar = PI * j / rings, az = 2.0 * PI * i / seg;
-            v[3 * n] = 0.3 * sin(polar) * cos(az);
-            v[3 * n + 1] = 0.3 * sin(polar) * sin(az);
-            v[3 * n + 2] = 0.3 * cos(polar);
-        }
-    v[3 * n] = v[3 * n + 1] = 0.0, v[3 * n + 2] = -0.3;
-    int32_t bottom = n++, base = 1 + (rings - 2) * seg;
-    for (int32_t i = 0; i < seg; ++i) t[k++] = 0, t[k++] = 1 + i, t[k++] = 1 + (i + 1) % seg;
-    for (int32_t j = 0; j + 2 < rings; ++j)
-        for (int32_t i = 0; i < seg; ++i) {
-            int32_t a = 1 + j * seg + i, b = 1 + j * seg + (i + 1) % seg;
-            t[k++] = a, t[k++] = a + seg, t[k++] = b;
-            t[k++] = b, t[k++] = a + seg, t[k++] = b + seg;
-        }
-    for (int32_t i = 0; i < seg; ++i) t[k++] = bottom, t[k++] = base + (i + 1) % seg, t[k++] = base + i;
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertices = v, d.vertex_count = n, d.triangles = t, d.triangle_count = k / 3;
-    check(wc_world_add_mesh_collider(w, &d, &col), w, "add sphere");
-}
 
 typedef struct run_result {
     double wall_per_second; /* wall s per simulated s */
@@ -91,24 +49,24 @@ static run_result run(int size, int self, wc_integrator integrator, int substeps
         fprintf(stderr, "wc_world_create: %s\n", msg.text);
         exit(1);
     }
-    add_sphere(w);
+    bench_add_thesis_sphere(w);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = size;
     g.center[2] = 0.6;
     g.self_collision = self;
     int32_t cl;
-    check(wc_world_add_grid_cloth(w, &g, &cl), w, "add cloth");
+    bench_check(wc_world_add_grid_cloth(w, &g, &cl), w, "add cloth");
     if (substeps < 0) substeps = -substeps * (int)ceil(1.0 / 24 / (wd.substep_safety * wc_world_stable_dt(w)));
     run_result r = {0.0, 0, 0, NULL};
     int frames = (int)lround(seconds * 24);
-    double t0 = now();
+    double t0 = bench_now();
     for (int f = 0; f < frames; ++f) {
         if (wc_world_advance(w, 1.0 / 24, substeps) != WC_OK) {
             r.failed = 1;
             break;
         }
     }
-    r.wall_per_second = (now() - t0) / seconds;
+    r.wall_per_second = (bench_now() - t0) / seconds;
     r.substeps = wc_world_last_substeps(w);
     int32_t n = wc_cloth_particle_count(w, cl);
     r.positions = malloc(3 * (size_t)n * sizeof *r.positions);

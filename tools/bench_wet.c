@@ -35,52 +35,10 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "wetcloth.h"
 
-#define PI 3.14159265358979323846
 #define FRAMES 48
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static void check(wc_status s, const wc_world *w, const char *what)
-{
-    if (s == WC_OK) return;
-    fprintf(stderr, "%s failed: %s: %s\n", what, wc_status_name(s), w ? wc_world_last_error(w) : "");
-    exit(1);
-}
-
-/* The thesis' solid: UV sphere, 16 segments x 8 rings = 114 vertices. */
-static void add_sphere(wc_world *w)
-{
-    double v[3 * 114];
-    int32_t t[3 * 224], n = 0, k = 0, seg = 16, rings = 8, col;
-    v[0] = v[1] = 0.0, v[2] = 0.3, n = 1;
-    for (int32_t j = 1; j < rings; ++j)
-        for (int32_t i = 0; i < seg; ++i, ++n) {
-            double polar = PI * j / rings, az = 2.0 * PI * i / seg;
-            v[3 * n] = 0.3 * sin(polar) * cos(az);
-            v[3 * n + 1] = 0.3 * sin(polar) * sin(az);
-            v[3 * n + 2] = 0.3 * cos(polar);
-        }
-    v[3 * n] = v[3 * n + 1] = 0.0, v[3 * n + 2] = -0.3;
-    int32_t bottom = n++, base = 1 + (rings - 2) * seg;
-    for (int32_t i = 0; i < seg; ++i) t[k++] = 0, t[k++] = 1 + i, t[k++] = 1 + (i + 1) % seg;
-    for (int32_t j = 0; j + 2 < rings; ++j)
-        for (int32_t i = 0; i < seg; ++i) {
-            int32_t a = 1 + j * seg + i, b = 1 + j * seg + (i + 1) % seg;
-            t[k++] = a, t[k++] = a + seg, t[k++] = b;
-            t[k++] = b, t[k++] = a + seg, t[k++] = b + seg;
-        }
-    for (int32_t i = 0; i < seg; ++i) t[k++] = bottom, t[k++] = base + (i + 1) % seg, t[k++] = base + i;
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertices = v, d.vertex_count = n, d.triangles = t, d.triangle_count = k / 3;
-    check(wc_world_add_mesh_collider(w, &d, &col), w, "add sphere");
-}
 
 enum { PLAIN, DRY, WET, WET_AUTO, CONFIGS };
 static const char *const names[CONFIGS] = {"plain", "dry", "wet", "wet-auto"};
@@ -95,7 +53,7 @@ static wc_world *scene(int size, int config, int threads, int32_t *cloth)
         fprintf(stderr, "wc_world_create: %s\n", msg.text);
         exit(1);
     }
-    add_sphere(w);
+    bench_add_thesis_sphere(w);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = size;
     g.center[2] = 0.6;
@@ -104,7 +62,7 @@ static wc_world *scene(int size, int config, int threads, int32_t *cloth)
         g.material.wet_mass_gain = 0.0, g.material.wet_softening = 0.0;
     }
     g.wetness = config >= WET ? 1.0 : 0.0;
-    check(wc_world_add_grid_cloth(w, &g, cloth), w, "add cloth");
+    bench_check(wc_world_add_grid_cloth(w, &g, cloth), w, "add cloth");
     return w;
 }
 
@@ -119,16 +77,16 @@ static result run(int size, int config, int threads, int32_t substeps)
     int32_t cloth;
     wc_world *w = scene(size, config, threads, &cloth);
     result r = {0.0, 0, 0, 0, 0};
-    double t0 = now();
+    double t0 = bench_now();
     for (int f = 0; f < FRAMES; ++f) {
-        check(wc_world_advance(w, 1.0 / 24, substeps), w, "advance");
+        bench_check(wc_world_advance(w, 1.0 / 24, substeps), w, "advance");
         r.steps += wc_world_last_substeps(w);
     }
-    r.seconds = now() - t0;
+    r.seconds = bench_now() - t0;
     wc_step_stats st = wc_world_get_stats(w);
     r.contacts = st.collider_contacts, r.stuck = st.stuck_particles;
     wc_intersection_counts ic;
-    check(wc_world_count_intersections(w, &ic), w, "count intersections");
+    bench_check(wc_world_count_intersections(w, &ic), w, "count intersections");
     r.intersections = ic.cloth_cloth + ic.cloth_collider;
     wc_world_destroy(w);
     return r;

@@ -24,18 +24,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench_util.h"
 #include "wetcloth.h"
 
 #define PI 3.14159265358979323846
 
 static const char *out_dir;
-
-static void check(wc_status s, const wc_world *w, const char *what)
-{
-    if (s == WC_OK) return;
-    fprintf(stderr, "wet_scenes: %s failed: %s: %s\n", what, wc_status_name(s), w ? wc_world_last_error(w) : "");
-    exit(1);
-}
 
 static wc_world *world(double gz)
 {
@@ -49,31 +43,6 @@ static wc_world *world(double gz)
         exit(1);
     }
     return w;
-}
-
-static void sphere_mesh(wc_world *w)
-{
-    double v[3 * 114];
-    int32_t t[3 * 224], n = 1, k = 0, seg = 16, rings = 8, col;
-    v[0] = v[1] = 0.0, v[2] = 0.3;
-    for (int32_t j = 1; j < rings; ++j)
-        for (int32_t i = 0; i < seg; ++i, ++n) {
-            double polar = PI * j / rings, az = 2.0 * PI * i / seg;
-            v[3 * n] = 0.3 * sin(polar) * cos(az), v[3 * n + 1] = 0.3 * sin(polar) * sin(az);
-            v[3 * n + 2] = 0.3 * cos(polar);
-        }
-    v[3 * n] = v[3 * n + 1] = 0.0, v[3 * n + 2] = -0.3;
-    int32_t bottom = n++, base = 1 + (rings - 2) * seg;
-    for (int32_t i = 0; i < seg; ++i) t[k++] = 0, t[k++] = 1 + i, t[k++] = 1 + (i + 1) % seg;
-    for (int32_t j = 0; j + 2 < rings; ++j)
-        for (int32_t i = 0; i < seg; ++i) {
-            int32_t a = 1 + j * seg + i, b = 1 + j * seg + (i + 1) % seg;
-            t[k++] = a, t[k++] = a + seg, t[k++] = b, t[k++] = b, t[k++] = a + seg, t[k++] = b + seg;
-        }
-    for (int32_t i = 0; i < seg; ++i) t[k++] = bottom, t[k++] = base + (i + 1) % seg, t[k++] = base + i;
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertices = v, d.vertex_count = n, d.triangles = t, d.triangle_count = k / 3;
-    check(wc_world_add_mesh_collider(w, &d, &col), w, "add sphere");
 }
 
 static void plate_vertices(const double c[3], const double u[3], const double v[3], double size, double out[12])
@@ -91,18 +60,18 @@ static int32_t plate(wc_world *w, const double c[3], const double u[3], const do
     wc_mesh_collider_def d = wc_mesh_collider_def_default();
     d.vertices = verts, d.vertex_count = 4, d.triangles = tris, d.triangle_count = 2;
     int32_t out;
-    check(wc_world_add_mesh_collider(w, &d, &out), w, "add plate");
+    bench_check(wc_world_add_mesh_collider(w, &d, &out), w, "add plate");
     return out;
 }
 
 static int32_t grid(wc_world *w, const wc_grid_cloth_def *g)
 {
     int32_t cl;
-    check(wc_world_add_grid_cloth(w, g, &cl), w, "add cloth");
+    bench_check(wc_world_add_grid_cloth(w, g, &cl), w, "add cloth");
     return cl;
 }
 
-static void advance(wc_world *w, double dt) { check(wc_world_advance(w, dt, 0), w, "advance"); }
+static void advance(wc_world *w, double dt) { bench_check(wc_world_advance(w, dt, 0), w, "advance"); }
 
 /* Writes a cloth's particles (x, y, z, stuck) to OUT_DIR/name. */
 static void dump(const wc_world *w, int32_t cl, const char *name)
@@ -117,8 +86,8 @@ static void dump(const wc_world *w, int32_t cl, const char *name)
         fprintf(stderr, "wet_scenes: cannot write %s\n", path);
         exit(1);
     }
-    check(wc_cloth_get_positions(w, cl, p, n), w, "positions");
-    check(wc_cloth_get_stuck(w, cl, stuck, n), w, "stuck");
+    bench_check(wc_cloth_get_positions(w, cl, p, n), w, "positions");
+    bench_check(wc_cloth_get_stuck(w, cl, stuck, n), w, "stuck");
     fprintf(f, "x,y,z,stuck\n");
     for (int32_t i = 0; i < n; ++i) fprintf(f, "%.6f,%.6f,%.6f,%d\n", p[3 * i], p[3 * i + 1], p[3 * i + 2], stuck[i]);
     if (fclose(f) != 0) {
@@ -132,7 +101,7 @@ static int stuck_count(const wc_world *w, int32_t cl)
 {
     uint8_t s[441];
     int32_t n = wc_cloth_particle_count(w, cl);
-    check(wc_cloth_get_stuck(w, cl, s, n), w, "stuck");
+    bench_check(wc_cloth_get_stuck(w, cl, s, n), w, "stuck");
     int c = 0;
     for (int32_t i = 0; i < n; ++i) c += s[i];
     return c;
@@ -142,7 +111,7 @@ static void wrap(void)
 {
     for (int wet = 0; wet < 2; ++wet) {
         wc_world *w = world(-9.81);
-        sphere_mesh(w);
+        bench_add_thesis_sphere(w);
         wc_grid_cloth_def g = wc_grid_cloth_def_default();
         g.count_u = g.count_v = 20, g.center[2] = 0.6, g.wetness = wet;
         int32_t cl = grid(w, &g);
@@ -161,7 +130,7 @@ static void spreading(void)
         wc_convex_collider_def d = wc_convex_collider_def_default();
         d.radius = 0.3;
         int32_t col;
-        check(wc_world_add_convex_collider(w, &d, &col), w, "add sphere");
+        bench_check(wc_world_add_convex_collider(w, &d, &col), w, "add sphere");
         wc_grid_cloth_def g = wc_grid_cloth_def_default();
         g.count_u = g.count_v = 21, g.center[2] = 0.304, g.wetness = 1.0;
         g.material.adhesion = adhesion[k], g.material.bend_stiffness = bend[k];
@@ -207,16 +176,16 @@ static void slack(void)
         g.wetness = wet;
         int32_t cl = grid(w, &g), top[16];
         for (int i = 0; i < n; ++i) top[i] = (n - 1) * n + i;
-        check(wc_cloth_pin(w, cl, top, n), w, "pin");
+        bench_check(wc_cloth_pin(w, cl, top, n), w, "pin");
         double p[3 * 256], base[3 * 16], target[3 * 16];
-        check(wc_cloth_get_positions(w, cl, p, 256), w, "positions");
+        bench_check(wc_cloth_get_positions(w, cl, p, 256), w, "positions");
         for (int i = 0; i < n; ++i)
             for (int k = 0; k < 3; ++k) base[3 * i + k] = p[3 * top[i] + k];
         for (int f = 0; f < 48; ++f) {
             double s = f < 24 ? (f + 1.0) / 24 : 1.0;
             for (int i = 0; i < n; ++i)
                 for (int k = 0; k < 3; ++k) target[3 * i + k] = base[3 * i + k] + s * out * normal[k];
-            check(wc_cloth_set_pin_targets(w, cl, target, n), w, "pin targets");
+            bench_check(wc_cloth_set_pin_targets(w, cl, target, n), w, "pin targets");
             advance(w, 1.0 / 24);
         }
         dump(w, cl, wet ? "slack_wet_before.csv" : "slack_dry_before.csv");
@@ -226,7 +195,7 @@ static void slack(void)
                 for (int k = 0; k < 3; ++k) target[3 * i + k] = base[3 * i + k] + out * normal[k];
                 target[3 * i] += s * D;
             }
-            check(wc_cloth_set_pin_targets(w, cl, target, n), w, "pin targets");
+            bench_check(wc_cloth_set_pin_targets(w, cl, target, n), w, "pin targets");
             advance(w, 1.0 / 24);
         }
         dump(w, cl, wet ? "slack_wet_after.csv" : "slack_dry_after.csv");
@@ -248,16 +217,16 @@ static void fold(void)
         g.wetness = wet;
         int32_t cl = grid(w, &g);
         double p[3 * 105];
-        check(wc_cloth_get_positions(w, cl, p, 105), w, "positions");
+        bench_check(wc_cloth_get_positions(w, cl, p, 105), w, "positions");
         for (int i = 0; i < 105; ++i)
             if (fabs(p[3 * i]) < 0.15) p[3 * i + 2] += 0.02 * 0.5 * (1.0 + cos(PI * p[3 * i] / 0.15));
-        check(wc_cloth_set_positions(w, cl, p, 105), w, "set positions");
+        bench_check(wc_cloth_set_positions(w, cl, p, 105), w, "set positions");
         for (int f = 0; f < 24; ++f) {
             double s = f < 12 ? (f + 1.0) / 12 : 1.0;
             for (int k = 0; k < 2; ++k) {
                 double c[3] = {centers[k][0] + (k ? -s * D : s * D), 0, 0}, verts[12];
                 plate_vertices(c, u, v, size, verts);
-                check(wc_collider_set_vertices(w, plates[k], verts, 4), w, "move plate");
+                bench_check(wc_collider_set_vertices(w, plates[k], verts, 4), w, "move plate");
             }
             advance(w, 1.0 / 24);
         }
@@ -275,7 +244,7 @@ static void self_adhesion(void)
         g.wetness = wet;
         int32_t cl = grid(w, &g), pins[105], pin_count = 0;
         double p[3 * 105];
-        check(wc_cloth_get_positions(w, cl, p, 105), w, "positions");
+        bench_check(wc_cloth_get_positions(w, cl, p, 105), w, "positions");
         for (int i = 0; i < 105; ++i) {
             int column = i % 21;
             double x = 0.05 * column;
@@ -283,8 +252,8 @@ static void self_adhesion(void)
             p[3 * i + 2] = column <= 10 ? 0.0 : 0.0045;
             if (column <= 10) pins[pin_count++] = i;
         }
-        check(wc_cloth_set_positions(w, cl, p, 105), w, "set positions");
-        check(wc_cloth_pin(w, cl, pins, pin_count), w, "pin");
+        bench_check(wc_cloth_set_positions(w, cl, p, 105), w, "set positions");
+        bench_check(wc_cloth_pin(w, cl, pins, pin_count), w, "pin");
         for (int f = 0; f < 12; ++f) advance(w, 1.0 / 24);
         dump(w, cl, wet ? "self_wet.csv" : "self_dry.csv");
         wc_world_destroy(w);
@@ -298,7 +267,7 @@ static double spread_fraction(double adhesion, double bend)
     wc_convex_collider_def d = wc_convex_collider_def_default();
     d.radius = 0.3;
     int32_t col;
-    check(wc_world_add_convex_collider(w, &d, &col), w, "add sphere");
+    bench_check(wc_world_add_convex_collider(w, &d, &col), w, "add sphere");
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = 21, g.center[2] = 0.304, g.wetness = 1.0;
     g.material.adhesion = adhesion, g.material.bend_stiffness = bend;
@@ -322,20 +291,20 @@ static double fold_height(double bend)
     g.material.bend_stiffness = bend, g.wetness = 1.0;
     int32_t cl = grid(w, &g);
     double p[3 * 105], top = -INFINITY;
-    check(wc_cloth_get_positions(w, cl, p, 105), w, "positions");
+    bench_check(wc_cloth_get_positions(w, cl, p, 105), w, "positions");
     for (int i = 0; i < 105; ++i)
         if (fabs(p[3 * i]) < 0.15) p[3 * i + 2] += 0.02 * 0.5 * (1.0 + cos(PI * p[3 * i] / 0.15));
-    check(wc_cloth_set_positions(w, cl, p, 105), w, "set positions");
+    bench_check(wc_cloth_set_positions(w, cl, p, 105), w, "set positions");
     for (int f = 0; f < 24; ++f) {
         double s = f < 12 ? (f + 1.0) / 12 : 1.0;
         for (int k = 0; k < 2; ++k) {
             double c[3] = {centers[k][0] + (k ? -s * D : s * D), 0, 0}, verts[12];
             plate_vertices(c, u, v, size, verts);
-            check(wc_collider_set_vertices(w, plates[k], verts, 4), w, "move plate");
+            bench_check(wc_collider_set_vertices(w, plates[k], verts, 4), w, "move plate");
         }
         advance(w, 1.0 / 24);
     }
-    check(wc_cloth_get_positions(w, cl, p, 105), w, "positions");
+    bench_check(wc_cloth_get_positions(w, cl, p, 105), w, "positions");
     for (int i = 0; i < 105; ++i) top = fmax(top, p[3 * i + 2]);
     wc_world_destroy(w);
     return top;
