@@ -354,6 +354,19 @@ static void solve(const wc_cloth *c, wc_implicit_state *s, int threads)
     s->last_residual = bb > 0.0 ? sqrt(rr / bb) : 0.0;
 }
 
+/* First particle whose right-hand side is not finite, -1 if none. Forces
+ * that overflowed make it so, and CG would not notice: the norm of such a
+ * right-hand side is not > 0, so the solve would return no change and the
+ * step a finite but wrong state. */
+static int32_t first_non_finite_rhs(const wc_implicit_state *s)
+{
+    for (int32_t i = 0; i < s->n; ++i) {
+        const double *b = s->rhs + 3 * (size_t)i;
+        if (!isfinite(b[0]) || !isfinite(b[1]) || !isfinite(b[2])) return i;
+    }
+    return -1;
+}
+
 int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, int threads)
 {
     wc_implicit_state *s = c->implicit;
@@ -361,6 +374,8 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, int t
     start_velocities(c, s, dt, pin_fraction, threads);
     link_blocks(c, s, dt, threads);
     rhs_and_preconditioner(c, s, dt, threads);
+    int32_t bad = first_non_finite_rhs(s);
+    if (bad >= 0) return bad;
     solve(c, s, threads);
     /* v1 = v0 + dv, x1 = x + h v1; pins exactly at their targets */
 #pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)

@@ -7,7 +7,8 @@
  * live block), change nothing (counts unchanged; a failing step keeps the
  * positions bitwise and the time), and the world must go on: retrying the
  * call succeeds, and the run ends bitwise where a run that never failed
- * does. */
+ * does. All of it for each integrator: the large-step ones allocate their
+ * buffers at their first step. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -72,6 +73,8 @@ static void fail_at(long index)
 #define SIDE 10
 #define STEPS 12
 static const double DT = 2e-4;
+static wc_integrator g_integrator; /* the one this round tests */
+static const char *const INTEGRATOR_NAME[] = {"verlet", "xpbd", "implicit"};
 
 typedef struct scene {
     wc_world *w;
@@ -93,6 +96,7 @@ static wc_status op(scene *s, int k, const char **what)
         *what = "wc_world_create";
         wc_world_def def = wc_world_def_default();
         def.thread_count = 1;
+        def.integrator = g_integrator;
         wc_message msg;
         memset(&msg, 'x', sizeof msg);
         wc_status st = wc_world_create(&def, &s->w, &msg);
@@ -350,26 +354,36 @@ static void step_with_failure(int step, long offset)
     CHECK(g_bad_frees == 0, "%ld frees of unknown blocks", g_bad_frees);
 }
 
-int main(void)
+/* Every allocation of the setup and of each step fails in turn, for the
+ * world's current integrator. */
+static void fail_everything(void)
 {
-    sphere_nv = scene_uv_sphere(0.3, 16, 8, sphere_v, sphere_t, &sphere_nt);
-    wc_set_allocator(track_alloc, track_free, NULL);
-
     reference();
 
     long setup_points = 0;
     while (setup_with_failure(setup_points)) ++setup_points;
     CHECK(setup_points > 50, "the setup should allocate more than 50 times (%ld)", setup_points);
-    printf("setup: failed each of its %ld allocations in turn\n", setup_points);
 
     long step_points = 0;
     for (int step = 0; step < STEPS; ++step) {
         for (long k = 0; k < g_step_allocs[step]; ++k) step_with_failure(step, k);
         step_points += g_step_allocs[step];
-        if (g_step_allocs[step]) printf("step %d: failed each of its %ld allocations in turn\n",
-                                        step, g_step_allocs[step]);
     }
     CHECK(g_step_allocs[0] > 10, "the first step should allocate (%ld)", g_step_allocs[0]);
+    printf("%s: %ld setup and %ld step allocation failures contained\n",
+           INTEGRATOR_NAME[g_integrator], setup_points, step_points);
+}
+
+int main(void)
+{
+    sphere_nv = scene_uv_sphere(0.3, 16, 8, sphere_v, sphere_t, &sphere_nt);
+    wc_set_allocator(track_alloc, track_free, NULL);
+
+    const wc_integrator all[] = {WC_INTEGRATOR_VERLET, WC_INTEGRATOR_XPBD, WC_INTEGRATOR_IMPLICIT};
+    for (size_t k = 0; k < sizeof all / sizeof all[0]; ++k) {
+        g_integrator = all[k];
+        fail_everything();
+    }
 
     /* back to malloc: a world made now works and frees through free() */
     wc_set_allocator(NULL, NULL, NULL);
@@ -378,6 +392,5 @@ int main(void)
     CHECK(g_calls == calls, "the hook is still called after wc_set_allocator(NULL, NULL, NULL)");
     wc_world_destroy(w);
     free(g_live);
-    printf("%ld setup and %ld step allocation failures contained\n", setup_points, step_points);
     return test_report("test_oom");
 }
