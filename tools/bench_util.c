@@ -49,3 +49,42 @@ void bench_add_thesis_sphere(wc_world *w)
     d.vertices = v, d.vertex_count = n, d.triangles = t, d.triangle_count = k / 3;
     bench_check(wc_world_add_mesh_collider(w, &d, &col), w, "add sphere");
 }
+
+static void add_ground(wc_world *w, double half)
+{
+    double v[12] = {-half, -half, 0, half, -half, 0, half, half, 0, -half, half, 0};
+    int32_t t[6] = {0, 1, 2, 0, 2, 3}, col;
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertices = v, d.vertex_count = 4, d.triangles = t, d.triangle_count = 2;
+    bench_check(wc_world_add_mesh_collider(w, &d, &col), w, "add ground");
+}
+
+wc_world *bench_resting_world(int size, int self_collision, int threads, double *out_dt)
+{
+    wc_world_def wd = wc_world_def_default();
+    wd.thread_count = threads;
+    wc_world *w;
+    wc_message m;
+    bench_check(wc_world_create(&wd, &w, &m), NULL, m.text);
+    double width = (size - 1) / 63.0;
+    add_ground(w, width);
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = size;
+    g.size_u = g.size_v = width;
+    g.center[2] = g.material.thickness * 1.01;
+    g.self_collision = self_collision;
+    int32_t c;
+    bench_check(wc_world_add_grid_cloth(w, &g, &c), w, "add cloth");
+    double dt = wc_world_stable_dt(w);
+    for (int k = 0; k < 20; ++k) bench_check(wc_world_step(w, dt), w, "step");
+    *out_dt = dt;
+    return w;
+}
+
+void bench_check_resting(const wc_world *w, int size)
+{
+    if (wc_world_get_stats(w).collider_contacts < size * size / 2) {
+        fprintf(stderr, "resting %dx%d: the cloth is not on the ground\n", size, size);
+        exit(1);
+    }
+}

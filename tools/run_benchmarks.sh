@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build --target bench_core bench_collide bench_wet bench_integrators >/dev/null
+cmake --build build --target bench_core bench_collide bench_wet bench_integrators bench_threads >/dev/null
 out=docs/benchmarks.md
 tmp=$(mktemp "${out}.XXXXXX")
 trap 'rm -f "$tmp"' EXIT
@@ -81,6 +81,18 @@ trap 'rm -f "$tmp"' EXIT
   echo '```'
   build/tools/bench_integrators 0.5 1 2 20 100
   echo '```'
+  echo
+  echo "## Threads: 1 and 2 threads, 1k to 262k particles"
+  echo
+  echo "The same resting cloth at every size; positions must end bitwise the same for every thread"
+  echo "count (the program fails otherwise). 16 threads, on the 16-core machine lent for it:"
+  echo "[bench/threads-16.md](bench/threads-16.md)."
+  echo
+  echo '```'
+  echo "build/tools/bench_threads 50 1 2"
+  echo '```'
+  echo
+  build/tools/bench_threads 50 1 2
 } > "$tmp"
 mv "$tmp" "$out"
 trap - EXIT
