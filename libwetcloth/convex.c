@@ -326,7 +326,22 @@ typedef struct shape_obj {
     const wc_convex_shape *shape;
     double center[3];
     long calls;
+    long budget; /* support calls allowed, SUPPORT_BUDGET or less */
 } shape_obj;
+
+/* EPA inside a box or hull. Its polytope gains a vertex per support call
+ * and each iteration scans all its faces (libccd's ccdPtNearest), so a call
+ * that runs on rounding to the full SUPPORT_BUDGET costs ~budget^2: ~10 ms
+ * each, and a fuzz input with a degenerate hull took 5 s of a 12-step run
+ * in ccdPtNearest. The polytope's vertices are points of the shape (a box
+ * has 8), so past GJK's iterations and a few per vertex there is nothing
+ * new to find: that is the budget. */
+static long epa_budget(const wc_convex_shape *s)
+{
+    long vertices = s->shape == WC_SHAPE_BOX ? 8 : (long)s->point_count;
+    long budget = MPR_MAX_ITERATIONS + 64 + 4 * vertices;
+    return budget < SUPPORT_BUDGET ? budget : SUPPORT_BUDGET;
+}
 
 /* A ball (the particle), a segment swept by a ball (the particle over a
  * step), a point, or a triangle: object 1 of every libccd call here. */
@@ -344,7 +359,7 @@ static void shape_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *ou
     const wc_convex_shape *s = so->shape;
     const double *d = dir->v;
     double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    if (++so->calls > SUPPORT_BUDGET) {
+    if (++so->calls > so->budget) {
         /* A point far behind the direction asked for (libccd then sees no
          * progress and leaves whatever loop it is in); the caller sees the
          * exhausted budget and drops the result. */
@@ -447,14 +462,14 @@ static int mpr_ball(const wc_convex_shape *s, const double c[3], double r, doubl
 {
     probe_obj ball;
     ball_probe(&ball, c, r);
-    shape_obj so = {s, {0.0, 0.0, 0.0}, 0};
+    shape_obj so = {s, {0.0, 0.0, 0.0}, 0, SUPPORT_BUDGET};
     interior_point(s, so.center);
     ccd_t ccd;
     init_ccd(&ccd, scale);
     ccd_real_t d = 0.0;
     ccd_vec3_t v, pos;
     int rc = ccdMPRPenetration(&ball, &so, &ccd, &d, &v, &pos);
-    if (rc != 0 || so.calls > SUPPORT_BUDGET) return 0;
+    if (rc != 0 || so.calls > so.budget) return 0;
     double len = sqrt(v.v[0] * v.v[0] + v.v[1] * v.v[1] + v.v[2] * v.v[2]);
     /* a touching contact (depth 0) comes without a direction */
     if (!isfinite(d) || !(d > 0.0) || !(len > 0.5)) return 0;
@@ -472,14 +487,14 @@ static int epa_point(const wc_convex_shape *s, const double c[3], double scale, 
 {
     probe_obj pt;
     ball_probe(&pt, c, 0.0);
-    shape_obj so = {s, {0.0, 0.0, 0.0}, 0};
+    shape_obj so = {s, {0.0, 0.0, 0.0}, 0, epa_budget(s)};
     interior_point(s, so.center);
     ccd_t ccd;
     init_ccd(&ccd, scale);
     ccd_real_t d = 0.0;
     ccd_vec3_t v, pos;
     int rc = ccdGJKPenetration(&pt, &so, &ccd, &d, &v, &pos);
-    if (rc != 0 || so.calls > SUPPORT_BUDGET) return 0;
+    if (rc != 0 || so.calls > so.budget) return 0;
     double len = sqrt(v.v[0] * v.v[0] + v.v[1] * v.v[1] + v.v[2] * v.v[2]);
     if (!isfinite(d) || !(d > 0.0) || !(len > 0.5)) return 0;
     *depth = d;
@@ -764,12 +779,12 @@ static int sweep_hits(const wc_convex_shape *s, const double p[3], const double 
         cap.b[k] = q[k];
         cap.center[k] = 0.5 * (p[k] + q[k]);
     }
-    shape_obj so = {s, {0.0, 0.0, 0.0}, 0};
+    shape_obj so = {s, {0.0, 0.0, 0.0}, 0, SUPPORT_BUDGET};
     interior_point(s, so.center);
     ccd_t ccd;
     init_ccd(&ccd, scale_of(s, r) + norm3(p));
     int hit = ccdMPRIntersect(&cap, &so, &ccd);
-    return so.calls > SUPPORT_BUDGET ? 0 : hit;
+    return so.calls > so.budget ? 0 : hit;
 }
 
 /* Distance from the origin to segment a-b. */
@@ -900,11 +915,11 @@ int wc_convex_triangle_intersects(const wc_convex_shape *shape, const wc_pose *p
         tri.center[k] = (tri.a[k] + tri.b[k] + tri.c[k]) / 3.0;
     }
     if (gap2 > shape->bound_radius * shape->bound_radius) return 0;
-    shape_obj so = {shape, {0.0, 0.0, 0.0}, 0};
+    shape_obj so = {shape, {0.0, 0.0, 0.0}, 0, SUPPORT_BUDGET};
     interior_point(shape, so.center);
     ccd_t ccd;
     init_ccd(&ccd, shape->bound_radius + far);
     /* GJK, not MPR: MPR is unreliable for flat objects (NOTES). */
     int hit = ccdGJKIntersect(&tri, &so, &ccd);
-    return so.calls > SUPPORT_BUDGET ? 0 : hit;
+    return so.calls > so.budget ? 0 : hit;
 }

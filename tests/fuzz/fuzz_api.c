@@ -35,8 +35,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
  * tests and benchmarks. Without a budget a few inputs (24 advances of 8
  * substeps of a self-colliding cloth) took seconds under the sanitizers and
  * the run averaged ~20 inputs per second per core. An operation over the
- * budget is skipped; its bytes are still read, so the input decodes the same. */
+ * budget is skipped; its bytes are still read, so the input decodes the same.
+ * The environment variable WC_FUZZ_STEP_BUDGET (1 .. 1000) overrides it for
+ * a run. */
 #define STEP_BUDGET 12
+
+static int32_t step_budget(void)
+{
+    static int32_t budget = 0;
+    if (!budget) {
+        const char *e = getenv("WC_FUZZ_STEP_BUDGET");
+        long b = e ? strtol(e, NULL, 10) : STEP_BUDGET;
+        budget = b >= 1 && b <= 1000 ? (int32_t)b : STEP_BUDGET;
+    }
+    return budget;
+}
 
 static int32_t g_steps_left;
 
@@ -532,7 +545,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* automatic substepping only where the world caps it low */
     int auto_ok = def.max_substeps <= 64;
     int ops = 0;
-    g_steps_left = STEP_BUDGET - 1; /* one for the final step */
+    g_steps_left = step_budget() - 1; /* one for the final step */
     while (r.left && ops++ < MAX_OPS) {
         uint8_t op = u8(&r);
         switch (op % 10) {
