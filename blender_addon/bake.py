@@ -262,7 +262,8 @@ class Baker:
 
         gravity = tuple(scene.gravity) if scene.use_gravity else (0.0, 0.0, 0.0)
         try:
-            self.world = wetcloth.World(gravity=gravity)
+            self.world = wetcloth.World(gravity=gravity,
+                                        integrator=props.integrator_name(s))
             self.cloth = self.world.add_cloth(start_world, faces, material=material,
                                               wetness=wet, self_collision=s.self_collision)
             if self.pins.size:

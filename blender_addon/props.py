@@ -136,6 +136,18 @@ class WetClothSettings(bpy.types.PropertyGroup):
                              description="First baked frame (the cloth's rest state)")
     frame_end: IntProperty(name="End", default=250, min=1, max=1048574,
                            description="Last baked frame")
+    integrator: EnumProperty(
+        name="Integrator",
+        items=[("VERLET", "Verlet", "Position Verlet, the thesis' explicit method: the reference, "
+                "but a fine or stiff cloth needs hundreds of substeps per frame"),
+               ("XPBD", "Strain Limited",
+                "Stretch links as constraints (XPBD): stable at large steps for any stretch "
+                "stiffness"),
+               ("IMPLICIT", "Semi-Implicit",
+                "Backward Euler with conjugate gradients (Choi & Ko): stable at large steps, "
+                "damps more")],
+        default="VERLET",
+        description="How a step advances the cloth (docs/model.md, Integrators)")
     substeps_auto: BoolProperty(
         name="Automatic Substeps", default=True,
         description="Choose the steps per frame from the library's stable step")
@@ -158,6 +170,11 @@ def frame_range(settings, scene):
     if settings.use_scene_range:
         return scene.frame_start, scene.frame_end
     return settings.frame_start, settings.frame_end
+
+
+def integrator_name(settings):
+    """The wetcloth.World integrator name of the panel's choice."""
+    return settings.integrator.lower()
 
 
 def material_kwargs(settings):

@@ -125,6 +125,7 @@ class PHYSICS_PT_wet_cloth_cache(_WetClothSubPanel, bpy.types.Panel):
         else:
             sub.prop(s, "frame_start", text="Frame Start")
             sub.prop(s, "frame_end", text="End")
+        col.prop(s, "integrator")
         col.prop(s, "substeps_auto")
         sub = col.column()
         sub.active = not s.substeps_auto

@@ -22,8 +22,10 @@ int32_t wc_xpbd_color_count(const wc_xpbd_state *state);
 
 /// Writes the positions after a step of dt into cloth->nx/ny/nz: the
 /// Verlet prediction from cloth->fx/fy/fz (which hold every force but the
-/// stretch links'), then one projection of every taut stretch link. Pinned
-/// particles are placed as in Verlet and never moved by a projection.
+/// stretch links'), then the backward-Euler dashpot of every stretch link
+/// slack at the prediction, then a Gauss-Seidel sweep of compliant
+/// projections over the taut ones. Pinned particles are placed as in Verlet
+/// and never moved by a projection.
 /// Returns the index of the first particle whose new position is not
 /// finite, or -1 when all are. cloth->xpbd must exist.
 int32_t wc_integrate_xpbd(wc_cloth *cloth, double dt, double pin_fraction, int threads);

@@ -1,19 +1,35 @@
-/* The three integrators on the thesis drape: wall time per simulated second
- * against error, side by side in one run (issue 7).
+/* The three integrators on the thesis drape: wall time per simulated frame
+ * against error, measured as issue 8 defines it (issue 7's targets).
  *
- *   build/tools/bench_integrators [seconds=1] [threads=1] [reference_factor=4] [sizes...=20 100]
+ *   build/tools/bench_integrators [options]
+ *     seconds=0.5        simulated time (frames of 1/24 s)
+ *     threads=1          OpenMP threads
+ *     sizes=20,101       n of the n x n grid cloths (101^2 = 10,201 particles,
+ *                        the size of Blender's figures in NOTES)
+ *     self=0,1           self-collision off, on
+ *     integrators=verlet,xpbd,implicit
+ *     steps=2,3,5,8,12,20,30,50   substeps per frame swept for xpbd and
+ *                        implicit (Verlet runs at its automatic count, the
+ *                        fewest it is stable at)
+ *     target=0.01        error bound of the summary
+ *     stop=1             stop a sweep at the first setting within target
  *
  * Scene: an n x n grid cloth (default cotton), 1 m wide, 0.6 m above the
- * 114-vertex UV sphere (radius 0.3 m), falling onto it for `seconds` in
- * frames of 1/24 s, self-collision off and on. Each integrator runs with
- * automatic substeps (its own stable step, wc_world_advance(.., 0)) and,
- * for the large-step integrators, also at 5 steps per frame (Blender's
- * default quality). The reference is Verlet at `reference_factor` times
- * its automatic substeps. Error: the largest and the mean distance of a
- * particle from the reference at the end, as a fraction of the cloth's
- * size (1 m). A run that fails (non-finite step) is reported as such.
- * Figures: wall seconds per simulated second (one run each; the machine
- * may be shared, see docs/benchmarks.md's header). */
+ * 114-vertex UV sphere (radius 0.3 m), falling onto it.
+ *
+ * Error (issue 8): RMS over particles and frames of the distance between the
+ * run and a reference run of the same scene and integrator at an 8x smaller
+ * step, at the same frame times, divided by the cloth's size (1 m). The
+ * column "vs verlet" is the same measure against Verlet at its automatic
+ * step, to show where the large-step integrators' answer lies.
+ *
+ * Cost: wall milliseconds per simulated frame (one run each; the machine may
+ * be shared: report its load). Blender's cloth on the same scene (NOTES, bpy
+ * 4.5.4, quality 5, this machine): 9.9 / 11.4 ms per frame at 400 particles
+ * (self-collision off / on), 220 / 2752 at 10,201; "x blender" divides those
+ * by ours for the sizes they were measured at. The summary picks, per
+ * integrator, the cheapest setting within the target and compares it with
+ * Blender's (target: 10x less time) and Verlet's (5x less). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdint.h>
@@ -25,23 +41,34 @@
 #include "bench_util.h"
 #include "wetcloth.h"
 
+#define MAX_LIST 32
 
+typedef struct options {
+    double seconds, target;
+    int threads, stop;
+    int sizes[MAX_LIST], size_count;
+    int selfs[MAX_LIST], self_count;
+    int integrators[MAX_LIST], integrator_count;
+    int steps[MAX_LIST], step_count;
+} options;
+
+/* One run: its positions at every frame end, its cost and its phases. */
 typedef struct run_result {
-    double wall_per_second; /* wall s per simulated s */
-    int substeps;           /* per frame (the last frame's) */
-    int failed;
-    double *positions;      /* 3 n^2, caller frees */
+    int substeps, frames, failed;
+    double ms_per_frame;
+    double cpu_ms_per_frame; /* process CPU time: less sensitive to a shared machine */
+    double phase_ms[3]; /* forces, integration, collisions; per frame */
+    double *positions;  /* frames x 3 n, caller frees */
+    int32_t n;
 } run_result;
 
 static const char *const NAMES[3] = {"verlet", "xpbd", "implicit"};
 
-/* substeps < 0: -substeps times the automatic count of the first frame */
-static run_result run(int size, int self, wc_integrator integrator, int substeps, double seconds,
-                      int threads)
+static wc_world *make_world(int size, int self, int integrator, int threads, int32_t *cloth)
 {
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
-    wd.integrator = integrator;
+    wd.integrator = (wc_integrator)integrator;
     wd.max_substeps = 10000000;
     wc_world *w = NULL;
     wc_message msg;
@@ -54,76 +81,223 @@ static run_result run(int size, int self, wc_integrator integrator, int substeps
     g.count_u = g.count_v = size;
     g.center[2] = 0.6;
     g.self_collision = self;
+    bench_check(wc_world_add_grid_cloth(w, &g, cloth), w, "add cloth");
+    return w;
+}
+
+/* CPU seconds of the whole process (all threads). */
+static double cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* substeps 0: the integrator's automatic count (its own stable step). */
+static run_result run(const options *o, int size, int self, int integrator, int substeps)
+{
     int32_t cl;
-    bench_check(wc_world_add_grid_cloth(w, &g, &cl), w, "add cloth");
-    if (substeps < 0) substeps = -substeps * (int)ceil(1.0 / 24 / (wd.substep_safety * wc_world_stable_dt(w)));
-    run_result r = {0.0, 0, 0, NULL};
-    int frames = (int)lround(seconds * 24);
-    double t0 = bench_now();
-    for (int f = 0; f < frames; ++f) {
-        if (wc_world_advance(w, 1.0 / 24, substeps) != WC_OK) {
+    wc_world *w = make_world(size, self, integrator, o->threads, &cl);
+    run_result r;
+    memset(&r, 0, sizeof r);
+    r.frames = (int)lround(o->seconds * 24);
+    r.n = wc_cloth_particle_count(w, cl);
+    r.positions = calloc((size_t)r.frames * 3 * (size_t)r.n, sizeof *r.positions);
+    if (!r.positions) exit(1);
+    double wall = 0.0, cpu = 0.0;
+    for (int f = 0; f < r.frames; ++f) {
+        double t0 = bench_now(), c0 = cpu_now();
+        wc_status s = wc_world_advance(w, 1.0 / 24, substeps);
+        wall += bench_now() - t0;
+        cpu += cpu_now() - c0;
+        if (s != WC_OK) {
             r.failed = 1;
             break;
         }
+        wc_step_stats st = wc_world_get_stats(w);
+        r.phase_ms[0] += 1e3 * st.force_seconds;
+        r.phase_ms[1] += 1e3 * st.integrate_seconds;
+        r.phase_ms[2] += 1e3 * st.collide_seconds;
+        wc_cloth_get_positions(w, cl, r.positions + (size_t)f * 3 * (size_t)r.n, r.n);
     }
-    r.wall_per_second = (bench_now() - t0) / seconds;
     r.substeps = wc_world_last_substeps(w);
-    int32_t n = wc_cloth_particle_count(w, cl);
-    r.positions = malloc(3 * (size_t)n * sizeof *r.positions);
-    wc_cloth_get_positions(w, cl, r.positions, n);
+    r.ms_per_frame = 1e3 * wall / r.frames;
+    r.cpu_ms_per_frame = 1e3 * cpu / r.frames;
+    for (int k = 0; k < 3; ++k) r.phase_ms[k] /= r.frames;
     wc_world_destroy(w);
     return r;
 }
 
-static void errors(const double *a, const double *b, int32_t n, double *worst, double *mean)
+/* Issue 8's error: RMS distance over particles and frames / cloth size (1 m). */
+static double rms_error(const run_result *a, const run_result *b)
 {
-    *worst = 0.0, *mean = 0.0;
-    for (int32_t i = 0; i < n; ++i) {
-        double d = sqrt((a[3 * i] - b[3 * i]) * (a[3 * i] - b[3 * i]) +
-                        (a[3 * i + 1] - b[3 * i + 1]) * (a[3 * i + 1] - b[3 * i + 1]) +
-                        (a[3 * i + 2] - b[3 * i + 2]) * (a[3 * i + 2] - b[3 * i + 2]));
-        *worst = fmax(*worst, d);
-        *mean += d / n;
+    if (a->failed || b->failed) return NAN;
+    double sum = 0.0;
+    size_t len = (size_t)a->frames * 3 * (size_t)a->n;
+    for (size_t i = 0; i < len; ++i) {
+        double d = a->positions[i] - b->positions[i];
+        sum += d * d;
     }
+    return sqrt(sum / ((double)a->frames * a->n)) / 1.0;
+}
+
+/* Blender's ms per frame on the same scene (NOTES), 0 where not measured. */
+static double blender_ms(int size, int self)
+{
+    if (size == 20) return self ? 11.4 : 9.9;
+    if (size == 101) return self ? 2752.0 : 220.0;
+    return 0.0;
+}
+
+typedef struct best {
+    int found, substeps;
+    double ms, cpu_ms, error;
+} best;
+
+static void print_row(int size, int self, int integrator, const run_result *r, double error,
+                      double vs_verlet)
+{
+    double blender = blender_ms(size, self);
+    printf("%-9d %-4s %-9s %8d %10.2f %8.2f %7.2f %7.2f %7.2f %10.2e %10.2e", size * size,
+           self ? "on" : "off", NAMES[integrator], r->substeps, r->ms_per_frame,
+           r->cpu_ms_per_frame, r->phase_ms[0],
+           r->phase_ms[1], r->phase_ms[2], error, vs_verlet);
+    if (blender > 0.0)
+        printf(" %9.2f", blender / r->ms_per_frame);
+    else
+        printf(" %9s", "-");
+    printf("%s\n", r->failed ? "  FAILED (non-finite step)" : "");
+    fflush(stdout);
+}
+
+/* Runs one integrator on one scene: Verlet at its automatic count, the others
+ * over o->steps; each against its own run at 8x the substeps. */
+static best sweep(const options *o, int size, int self, int integrator, const run_result *verlet)
+{
+    best b = {0, 0, 0.0, 0.0, 0.0};
+    int counts[MAX_LIST], count = 0;
+    if (integrator == 0) {
+        counts[count++] = 0;
+    } else {
+        for (int k = 0; k < o->step_count; ++k) counts[count++] = o->steps[k];
+    }
+    for (int k = 0; k < count; ++k) {
+        /* Verlet's run at its automatic count is the one passed in */
+        int reuse = integrator == 0 && verlet;
+        run_result r = reuse ? *verlet : run(o, size, self, integrator, counts[k]);
+        run_result ref = run(o, size, self, integrator, 8 * r.substeps);
+        double error = rms_error(&r, &ref);
+        double vs_verlet = verlet ? rms_error(&r, verlet) : 0.0;
+        print_row(size, self, integrator, &r, error, vs_verlet);
+        if (!r.failed && error <= o->target && (!b.found || r.ms_per_frame < b.ms)) {
+            b.found = 1, b.substeps = r.substeps, b.ms = r.ms_per_frame, b.error = error;
+            b.cpu_ms = r.cpu_ms_per_frame;
+        }
+        if (!reuse) free(r.positions);
+        free(ref.positions);
+        if (b.found && o->stop) break;
+    }
+    return b;
+}
+
+static int parse_list(const char *text, int *out, int is_integrator)
+{
+    int count = 0;
+    char buf[512];
+    snprintf(buf, sizeof buf, "%s", text);
+    for (char *tok = strtok(buf, ","); tok && count < MAX_LIST; tok = strtok(NULL, ",")) {
+        if (is_integrator) {
+            int k = 0;
+            while (k < 3 && strcmp(tok, NAMES[k])) ++k;
+            if (k == 3) {
+                fprintf(stderr, "integrators: unknown integrator '%s'\n", tok);
+                exit(2);
+            }
+            out[count++] = k;
+        } else {
+            out[count++] = atoi(tok);
+        }
+    }
+    return count;
+}
+
+static options parse(int argc, char **argv)
+{
+    options o;
+    memset(&o, 0, sizeof o);
+    o.seconds = 0.5, o.threads = 1, o.target = 0.01, o.stop = 1;
+    o.size_count = parse_list("20,101", o.sizes, 0);
+    o.self_count = parse_list("0,1", o.selfs, 0);
+    o.integrator_count = parse_list("verlet,xpbd,implicit", o.integrators, 1);
+    o.step_count = parse_list("2,3,5,8,12,20,30,50", o.steps, 0);
+    for (int i = 1; i < argc; ++i) {
+        const char *eq = strchr(argv[i], '=');
+        if (!eq) {
+            fprintf(stderr, "arguments are key=value (see tools/bench_integrators.c): %s\n", argv[i]);
+            exit(2);
+        }
+        size_t len = (size_t)(eq - argv[i]);
+        const char *v = eq + 1;
+        if (!strncmp(argv[i], "seconds", len)) o.seconds = atof(v);
+        else if (!strncmp(argv[i], "threads", len)) o.threads = atoi(v);
+        else if (!strncmp(argv[i], "target", len)) o.target = atof(v);
+        else if (!strncmp(argv[i], "stop", len)) o.stop = atoi(v);
+        else if (!strncmp(argv[i], "sizes", len)) o.size_count = parse_list(v, o.sizes, 0);
+        else if (!strncmp(argv[i], "self", len)) o.self_count = parse_list(v, o.selfs, 0);
+        else if (!strncmp(argv[i], "integrators", len))
+            o.integrator_count = parse_list(v, o.integrators, 1);
+        else if (!strncmp(argv[i], "steps", len)) o.step_count = parse_list(v, o.steps, 0);
+        else {
+            fprintf(stderr, "unknown option %s\n", argv[i]);
+            exit(2);
+        }
+    }
+    return o;
 }
 
 int main(int argc, char **argv)
 {
-    double seconds = argc > 1 ? atof(argv[1]) : 1.0;
-    int threads = argc > 2 ? atoi(argv[2]) : 1;
-    int factor = argc > 3 ? atoi(argv[3]) : 4;
-    int sizes[16] = {20, 100}, size_count = 2;
-    if (argc > 4) {
-        size_count = 0;
-        for (int i = 4; i < argc && size_count < 16; ++i) sizes[size_count++] = atoi(argv[i]);
-    }
-    printf("thesis drape, %.2f s simulated at 24 fps, %d thread(s); reference: verlet at %d x its "
-           "automatic substeps. error = distance from the reference at the end / cloth size (1 m)\n\n",
-           seconds, threads, factor);
-    printf("%-9s %-5s %-9s %-10s %12s %12s %11s %11s %10s\n", "particles", "self", "integrator",
-           "steps", "substeps/fr", "wall s/sim s", "max error", "mean error", "vs verlet");
-    for (int s = 0; s < size_count; ++s)
-        for (int self = 0; self < 2; ++self) {
-            int n = sizes[s];
-            run_result ref = run(n, self, WC_INTEGRATOR_VERLET, -factor, seconds, threads);
-            if (ref.failed) printf("reference failed for %d^2, self %d\n", n, self);
-            double verlet_wall = 0.0;
-            for (int k = 0; k < 3; ++k)
-                for (int mode = 0; mode < 2; ++mode) {
-                    if (k == 0 && mode == 1) continue;
-                    int sub = mode == 0 ? 0 : 5;
-                    run_result r = run(n, self, (wc_integrator)k, sub, seconds, threads);
-                    double worst, mean;
-                    errors(r.positions, ref.positions, n * n, &worst, &mean);
-                    if (k == 0) verlet_wall = r.wall_per_second;
-                    printf("%-9d %-5s %-9s %-10s %12d %12.3f %11.2e %11.2e %9.1fx%s\n", n * n,
-                           self ? "on" : "off", NAMES[k], mode == 0 ? "automatic" : "5/frame",
-                           r.substeps, r.wall_per_second, worst, mean,
-                           verlet_wall / r.wall_per_second, r.failed ? "  (FAILED: non-finite)" : "");
-                    fflush(stdout);
-                    free(r.positions);
+    options o = parse(argc, argv);
+    printf("thesis drape, %.2f s simulated (%d frames of 1/24 s), %d thread(s). error: RMS "
+           "distance over particles and frames to the same integrator at 8x the substeps, / 1 m; "
+           "vs verlet: the same against Verlet at its automatic step. ms per simulated frame, "
+           "its CPU time (cpu ms, all threads), the phases forces / integration / collisions (wall). x blender: Blender's ms per frame "
+           "(NOTES) / ours.\n\n",
+           o.seconds, (int)lround(o.seconds * 24), o.threads);
+    printf("%-9s %-4s %-9s %8s %10s %8s %7s %7s %7s %10s %10s %9s\n", "particles", "self",
+           "integr.", "steps/fr", "ms/frame", "cpu ms", "force", "integr", "collide", "error", "vs verlet",
+           "x blender");
+    char summary[MAX_LIST * MAX_LIST * 3][200];
+    int lines = 0;
+    for (int s = 0; s < o.size_count; ++s)
+        for (int si = 0; si < o.self_count; ++si) {
+            int n = o.sizes[s], self = o.selfs[si];
+            run_result verlet = run(&o, n, self, 0, 0);
+            best verlet_best = {0, 0, 0.0, 0.0, 0.0};
+            for (int k = 0; k < o.integrator_count; ++k) {
+                int integrator = o.integrators[k];
+                best b = sweep(&o, n, self, integrator, &verlet);
+                if (integrator == 0) verlet_best = b;
+                double blender = blender_ms(n, self);
+                if (!b.found) {
+                    snprintf(summary[lines++], 200, "%-9d %-4s %-9s none within %.0e", n * n,
+                             self ? "on" : "off", NAMES[integrator], o.target);
+                    continue;
                 }
-            free(ref.positions);
+                char vb[32] = "-", vv[32] = "-";
+                if (blender > 0.0) snprintf(vb, sizeof vb, "%.2fx", blender / b.ms);
+                if (verlet_best.found) snprintf(vv, sizeof vv, "%.2fx", verlet_best.ms / b.ms);
+                snprintf(summary[lines++], 200, "%-9d %-4s %-9s %8d %10.2f %8.2f %10.2e %10s %10s",
+                         n * n, self ? "on" : "off", NAMES[integrator], b.substeps, b.ms,
+                         b.cpu_ms, b.error, vb, vv);
+            }
+            free(verlet.positions);
         }
+    printf("\ncheapest setting with error <= %.0e (targets: 10x less time than Blender, 5x less "
+           "than Verlet)\n",
+           o.target);
+    printf("%-9s %-4s %-9s %8s %10s %8s %10s %10s %10s\n", "particles", "self", "integr.",
+           "steps/fr", "ms/frame", "cpu ms", "error", "x blender", "x verlet");
+    for (int i = 0; i < lines; ++i) printf("%s\n", summary[i]);
     return 0;
 }

@@ -194,6 +194,34 @@ def test_drape_cache(draped):
     assert not inside.any(), np.argwhere(inside)[:5]
 
 
+@pytest.mark.parametrize("integrator", ["XPBD", "IMPLICIT"])
+def test_integrator_choice_drapes_in_fewer_substeps(empty_scene, cache_dir, integrator):
+    """The panel's integrator reaches the world: the large-step integrators
+    drape the same cloth onto the sphere (on top, nothing inside) in fewer
+    automatic substeps per frame than Verlet's."""
+    sphere = add_sphere()
+    cloth = add_cloth(cache_dir)
+    original = positions(cloth.data).copy()
+    s = cloth.wet_cloth
+    assert s.integrator == "VERLET"
+    assert bake(cloth) == {"FINISHED"}
+    verlet_substeps = float(s.bake_info.split(", ")[1].split()[0])
+    _, verlet_frames = read_pc2(cache_path(cloth))
+    s.integrator = integrator
+    assert bake(cloth) == {"FINISHED"}
+    substeps = float(s.bake_info.split(", ")[1].split()[0])
+    assert substeps < verlet_substeps / 4, (substeps, verlet_substeps)
+    _, frames = read_pc2(cache_path(cloth))
+    world = frames.astype(np.float64) + np.array(cloth.location)
+    mid = np.argmin(np.linalg.norm(original[:, :2], axis=1))
+    assert SPHERE_R < world[-1, mid, 2] < SPHERE_R + 0.04
+    normals, offsets = convex_planes(sphere)
+    inside = np.all(world @ normals.T < offsets[None, None, :], axis=2)
+    assert not inside.any(), np.argwhere(inside)[:5]
+    # a different integrator, not Verlet's cache again
+    assert np.abs(frames[-1] - verlet_frames[-1]).max() > 1e-6
+
+
 def test_mesh_cache_plays_the_cache(draped):
     cloth, _sphere, original = draped
     mod = cloth.modifiers["Wet Cloth Cache"]
