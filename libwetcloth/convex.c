@@ -47,6 +47,10 @@
  * a support-call budget (see shape_support) ends any call that runs away
  * on rounding, and the call's result is then discarded. */
 #define MPR_MAX_ITERATIONS 200
+/* Largest distance from the shape, as a multiple of its size, at which MPR
+ * is asked anything (see sweep_hits). A particle this far out has moved a
+ * million shape sizes in one step. */
+#define MPR_LARGEST_PROBLEM 1e6
 #define SUPPORT_BUDGET 4000
 /* Penetrations below this fraction of the problem's size count as touching,
  * not contact: a ball just put back at distance r must not be found in
@@ -767,9 +771,18 @@ int wc_convex_penetration(const wc_convex_shape *shape, const double c[3], doubl
 /* Moving particles                                                          */
 /* ------------------------------------------------------------------------ */
 
-/* Whether the ball of radius r swept from p to q overlaps the shape. */
+/* Whether the ball of radius r swept from p to q overlaps the shape.
+ *
+ * MPR's arithmetic needs the problem near the shape's size: libccd's portal
+ * loop has no iteration cap, and with a path ~1e80 times the shape (an
+ * exploded cloth moving 1e81 m in a step, found by fuzzing) rounding keeps
+ * it turning forever, past the support budget's far point. A path that long
+ * which the caller has already seen pass within reach of the shape (its
+ * bounding-ball test) counts as a hit; first_contact's bisection then finds
+ * where it enters, with bounded work. */
 static int sweep_hits(const wc_convex_shape *s, const double p[3], const double q[3], double r)
 {
+    if (!(fmax(norm3(p), norm3(q)) <= MPR_LARGEST_PROBLEM * scale_of(s, r))) return 1;
     probe_obj cap;
     memset(&cap, 0, sizeof cap);
     cap.kind = 2;

@@ -768,8 +768,30 @@ static void test_validation(void)
     CHECK(s.points == NULL, "free left the points");
 }
 
+/* An exploded cloth's particle moving from ~1e72 m to ~2e81 m in one step
+ * on a line that passes within reach of a capsule (the coordinates of a
+ * fuzz input that timed out): libccd's MPR, asked whether that path meets
+ * the capsule, turned forever on rounding. Checked: wc_convex_resolve
+ * returns (without the fix this test hangs until ctest's timeout), and
+ * what it gives is finite. */
+static void test_exploded_path(void)
+{
+    wc_convex_collider_def d = wc_convex_collider_def_default();
+    d.shape = WC_SHAPE_CAPSULE;
+    d.radius = d.half_height = 0.5;
+    wc_convex_shape s = make(&d);
+    const double a[3] = {1.1527361862470264e+72, -8.5614729931985079e+71, -8.1971527105887753e+70};
+    const double b[3] = {-2.3567254664727314e+81, 1.7503607221076334e+81, 1.6758768203942447e+80};
+    double out[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+    if (wc_convex_resolve(&s, a, b, 0.005, out, n))
+        for (int k = 0; k < 3; ++k)
+            CHECK(isfinite(out[k]) && isfinite(n[k]), "exploded path: non-finite result");
+    wc_convex_shape_free(&s);
+}
+
 int main(void)
 {
+    test_exploded_path();
     for (int i = 0; i < 8; ++i)
         for (int k = 0; k < 3; ++k) cube_points[3 * i + k] = (i >> k) & 1 ? 0.5 : -0.5;
     test_sphere_points();
