@@ -355,7 +355,7 @@ static int convex_collider(particle_motion *m, const wc_collider *c, double r, d
 }
 
 void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count, double dt,
-                      int threads, wc_step_stats *stats)
+                      int threads, int all, const wc_collide_marks *marks, wc_step_stats *stats)
 {
     int32_t n = cl->particle_count;
     int failsafe = 0;
@@ -364,7 +364,8 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads) if (n >= WC_PARALLEL_MIN) \
     reduction(+ : failsafe)
     for (int32_t i = 0; i < n; ++i) {
-        if (cl->pin_slot[i] >= 0) continue;
+        if (cl->pin_slot[i] >= 0 || !(all || marks->recheck[i])) continue;
+        marks->recheck[i] = 0;
         particle_motion m;
         m.start[0] = cl->x[i], m.start[1] = cl->y[i], m.start[2] = cl->z[i];
         m.end[0] = cl->nx[i], m.end[1] = cl->ny[i], m.end[2] = cl->nz[i];
@@ -408,7 +409,9 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
                 m.end[k] = m.start[k] + m.vel[k] * dt;
             }
             ++failsafe;
+            marks->recheck[i] = 1;
         }
+        marks->shifted[i] = 1;
         cl->nx[i] = m.end[0], cl->ny[i] = m.end[1], cl->nz[i] = m.end[2];
         cl->qx[i] = m.end[0] - m.vel[0] * dt;
         cl->qy[i] = m.end[1] - m.vel[1] * dt;

@@ -39,6 +39,9 @@ struct wc_feature_state {
     /// 0 in the first pass (test everything), 1 after (only elements with a
     /// particle the previous pass moved: nothing else can have changed).
     int only_moved;
+    /// Between rounds (collide.h): recheck for the particle pass, shifted
+    /// for the first pass of the next call.
+    wc_collide_marks marks;
     /// Candidate collider features of one cloth element.
     int32_t *found;
     int32_t found_capacity;
@@ -117,10 +120,12 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
     s->moved = wc_alloc_array((size_t)c->particle_count, sizeof *s->moved);
     s->moving = wc_alloc_array((size_t)c->particle_count, sizeof *s->moving);
     s->carry = wc_alloc_array(3 * (size_t)c->particle_count, sizeof *s->carry);
+    s->marks.recheck = wc_alloc_array((size_t)c->particle_count, sizeof *s->marks.recheck);
+    s->marks.shifted = wc_alloc_array((size_t)c->particle_count, sizeof *s->marks.shifted);
     s->found_capacity = 256;
     s->found = wc_alloc_array((size_t)s->found_capacity, sizeof *s->found);
     if (!entries || !s->edges || !s->triangle_edges || !s->moved || !s->moving ||
-        !s->carry || !s->found) {
+        !s->carry || !s->marks.recheck || !s->marks.shifted || !s->found) {
         wc_free(entries);
         wc_feature_state_destroy(s);
         return NULL;
@@ -148,6 +153,8 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
 
 void wc_feature_state_keep_near_lists(wc_feature_state *s, int keep) { s->skip_near_lists = !keep; }
 
+const wc_collide_marks *wc_feature_state_marks(const wc_feature_state *s) { return &s->marks; }
+
 const wc_near_list *wc_feature_state_near_list(const wc_feature_state *s, int32_t collider)
 {
     if (!s || s->skip_near_lists || collider >= s->near_count) return NULL;
@@ -162,23 +169,25 @@ void wc_feature_state_destroy(wc_feature_state *s)
     wc_free(s->moved);
     wc_free(s->moving);
     wc_free(s->carry);
+    wc_free(s->marks.recheck);
+    wc_free(s->marks.shifted);
     wc_free(s->found);
     for (int32_t k = 0; k < s->near_count; ++k) wc_near_list_free(&s->near[k]);
     wc_free(s->near);
     wc_free(s);
 }
 
-/* Box of cloth triangle `tri` over the step (its corners' start and end
- * positions as they are now), grown by r. Made when used, not once per
- * call: the passes move particles, and a box from before they did could
- * miss what the move brought near. */
-static void triangle_box(const wc_cloth *c, const int32_t *tri, double r, double box[6])
+/* Box of a cloth element (`count` particles idx) over the step (its
+ * particles' start and end positions as they are now), grown by r. Made
+ * when used, not once per call: the passes move particles, and a box from
+ * before they did could miss what the move brought near. */
+static void element_box(const wc_cloth *c, const int32_t *idx, int count, double r, double box[6])
 {
     for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < count; ++k) {
         double p[2][3];
-        start_of(c, tri[k], p[0]);
-        end_of(c, tri[k], p[1]);
+        start_of(c, idx[k], p[0]);
+        end_of(c, idx[k], p[1]);
         for (int e = 0; e < 2; ++e)
             for (int d = 0; d < 3; ++d) {
                 box[d] = min2(box[d], p[e][d] - r);
@@ -277,31 +286,36 @@ static int push_element(wc_cloth *c, wc_feature_state *s, const int32_t *idx, co
             c->normal_x[i] = n[0], c->normal_y[i] = n[1], c->normal_z[i] = n[2];
         }
         s->moving[i] = 1;
+        s->marks.recheck[i] = 1;
         for (int d = 0; d < 3; ++d) s->carry[3 * (size_t)i + d] = v_feature[d] * dt;
     }
     return 1;
 }
 
-/* Box around points, grown by r. */
-static void feature_box(const double *const *points, int count, double r, double box[6])
-{
-    for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
-    for (int p = 0; p < count; ++p)
-        for (int k = 0; k < 3; ++k) {
-            box[k] = min2(box[k], points[p][k] - r);
-            box[k + 3] = max2(box[k + 3], points[p][k] + r);
-        }
-}
-
-/* Largest displacement over the step among `count` start/end point pairs. */
-static double largest_motion(const double *const *from, const double *const *to, int count)
+/* Largest squared displacement over the step of the given particles. */
+static double element_motion2(const wc_cloth *c, const int32_t *idx, int count)
 {
     double m = 0.0;
     for (int k = 0; k < count; ++k) {
-        double d[3] = {to[k][0] - from[k][0], to[k][1] - from[k][1], to[k][2] - from[k][2]};
+        int32_t i = idx[k];
+        double d[3] = {c->nx[i] - c->x[i], c->ny[i] - c->y[i], c->nz[i] - c->z[i]};
         m = max2(m, dot3(d, d));
     }
-    return sqrt(m);
+    return m;
+}
+
+/* Largest squared displacement over the step of collider vertices. */
+static double feature_motion2(const wc_collider *col, const int32_t *vertices, int count)
+{
+    double m = 0.0;
+    for (int k = 0; k < count; ++k) {
+        double v0[3], v1[3], d[3];
+        vertex_of(col->current, vertices[k], v0);
+        vertex_of(col->next, vertices[k], v1);
+        for (int j = 0; j < 3; ++j) d[j] = v1[j] - v0[j];
+        m = max2(m, dot3(d, d));
+    }
+    return m;
 }
 
 /* Continuous detection is needed only when the pair moved relative to each
@@ -309,20 +323,46 @@ static double largest_motion(const double *const *from, const double *const *to,
  * previous step saw to it), and distance changes no faster than the points
  * move, so a crossing with less motion than that still ends within r of
  * each other, where the proximity test sees it (and takes the side from the
- * start). Twice the largest motion bounds the relative motion. */
-static int needs_ccd(double largest, double r) { return 2.0 * largest > r; }
+ * start). Twice the largest squared motion `largest2` of the pair's points
+ * bounds the relative motion. */
+static int needs_ccd(double largest2, double r) { return 2.0 * sqrt(largest2) > r; }
 
-/* Collider vertex (v0 -> v1) against cloth triangle t. */
+/* The largest squared motion that needs no continuous detection: then
+ * needs_ccd(m, r) is m > ccd_limit2(r), with no square root per element.
+ * 2 sqrt(m) is correctly rounded and never falls as m grows, so stepping
+ * from (r / 2)^2 by single ulps finds the exact boundary. */
+static double ccd_limit2(double r)
+{
+    double m = 0.25 * r * r;
+    while (m > 0.0 && needs_ccd(m, r)) m = nextafter(m, 0.0);
+    while (!needs_ccd(nextafter(m, INFINITY), r)) m = nextafter(m, INFINITY);
+    return m;
+}
+
+/* The pair's own test, unless the collider stands still: then only the
+ * cloth element moves, and its motion was measured once for all its
+ * candidates. */
+static int pair_needs_ccd(const wc_collider *col, double element2, const int32_t *vertices,
+                          int count, double limit2)
+{
+    if (!col->moving) return element2 > limit2;
+    return max2(element2, feature_motion2(col, vertices, count)) > limit2;
+}
+
+/* Collider vertex (v0 -> v1) against cloth triangle t; `ccd` says whether
+ * the pair moved enough to need continuous detection. *d2 gets the squared
+ * distance between the vertex and the triangle at the end of the step as
+ * they were before any push. */
 static int vertex_triangle(wc_cloth *c, wc_feature_state *s, int32_t t, const double v0[3],
-                           const double v1[3], double r, double mu, double dt)
+                           const double v1[3], int ccd, double r, double mu, double dt, double *d2)
 {
     const int32_t *idx = c->topology.triangles + 3 * (size_t)t;
     double a0[3], b0[3], c0[3], a1[3], b1[3], c1[3], w[3], p1[3], p0[3], n1[3], n0[3], tc;
     start_of(c, idx[0], a0), start_of(c, idx[1], b0), start_of(c, idx[2], c0);
     end_of(c, idx[0], a1), end_of(c, idx[1], b1), end_of(c, idx[2], c1);
-    int hit = wc_point_triangle_closest(v1, a1, b1, c1, w) < r * r * (1.0 - SLACK);
-    const double *from[4] = {v0, a0, b0, c0}, *to[4] = {v1, a1, b1, c1};
-    if (!hit && needs_ccd(largest_motion(from, to, 4), r))
+    *d2 = wc_point_triangle_closest(v1, a1, b1, c1, w);
+    int hit = *d2 < r * r * (1.0 - SLACK);
+    if (!hit && ccd)
         hit = wc_ccd_point_triangle(v0, v1, a0, a1, b0, b1, c0, c1, 1e-9 * r, &tc, w);
     if (!hit) return 0;
     wc_triangle_normal(a1, b1, c1, n1);
@@ -349,18 +389,18 @@ static int vertex_triangle(wc_cloth *c, wc_feature_state *s, int32_t t, const do
 }
 
 /* Collider edge (p, q) against cloth edge e; their boxes over the step
- * overlap (the edge grid's query saw to it). */
+ * overlap (the edge grid's query saw to it). `ccd` and *d2 as for
+ * vertex_triangle. */
 static int edge_edge(wc_cloth *c, wc_feature_state *s, int32_t e, const double p0[3],
-                     const double p1[3], const double q0[3], const double q1[3], double r,
-                     double mu, double dt)
+                     const double p1[3], const double q0[3], const double q1[3], int ccd,
+                     double r, double mu, double dt, double *d2)
 {
     const int32_t *idx = s->edges + 2 * (size_t)e;
     double a0[3], b0[3], a1[3], b1[3], sp, u, tc;
     start_of(c, idx[0], a0), start_of(c, idx[1], b0);
     end_of(c, idx[0], a1), end_of(c, idx[1], b1);
-    const double *from[4] = {p0, q0, a0, b0}, *to[4] = {p1, q1, a1, b1};
-    int ccd = needs_ccd(largest_motion(from, to, 4), r);
-    int hit = wc_segment_segment_closest(p1, q1, a1, b1, &sp, &u) < r * r * (1.0 - SLACK);
+    *d2 = wc_segment_segment_closest(p1, q1, a1, b1, &sp, &u);
+    int hit = *d2 < r * r * (1.0 - SLACK);
     if (!hit && ccd)
         hit = wc_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &tc, &sp, &u);
     if (!hit) return 0;
@@ -385,6 +425,65 @@ static int edge_edge(wc_cloth *c, wc_feature_state *s, int32_t e, const double p
     double w[2] = {1.0 - u, u}, v_feature[3];
     for (int d = 0; d < 3; ++d) v_feature[d] = ((1.0 - sp) * (p1[d] - p0[d]) + sp * (q1[d] - q0[d])) / dt;
     return push_element(c, s, idx, w, 2, n, dot3(end_gap, n), r, v_feature, mu, dt);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Clearances (near_list.h)                                                 */
+/* ------------------------------------------------------------------------ */
+
+/* How far the element's particles (their ends) have gone at most from
+ * where its clearances were measured, squared. */
+static double drift2(const wc_cloth *c, const double *measured_at, const int32_t *idx, int count)
+{
+    double m = 0.0;
+    for (int k = 0; k < count; ++k) {
+        const double *at = measured_at + 3 * k;
+        int32_t i = idx[k];
+        double d[3] = {c->nx[i] - at[0], c->ny[i] - at[1], c->nz[i] - at[2]};
+        m = max2(m, dot3(d, d));
+    }
+    return m;
+}
+
+/* Distance between two boxes: no point of one is nearer to a point of
+ * the other. */
+static double box_gap(const double a[6], const double b[6])
+{
+    double g2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        double g = max2(0.0, max2(b[k] - a[k + 3], a[k] - b[k + 3]));
+        g2 += g * g;
+    }
+    return sqrt(g2);
+}
+
+/* Box around the element's particles at the end of the step. */
+static void end_box(const wc_cloth *c, const int32_t *idx, int count, double box[6])
+{
+    for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
+    for (int p = 0; p < count; ++p) {
+        double e[3];
+        end_of(c, idx[p], e);
+        for (int k = 0; k < 3; ++k) box[k] = min2(box[k], e[k]), box[k + 3] = max2(box[k + 3], e[k]);
+    }
+}
+
+/* After a visit of near-list element k: its clearances were measured at
+ * the particles' present ends, unless a push moved them part-way through
+ * the candidates, which leaves them unknown until the next visit. */
+static void settle_clearances(const wc_cloth *c, wc_near_elements *near, int32_t k,
+                              const int32_t *idx, int count, int pushed, double least)
+{
+    double *clearance = near->clearance + near->start[k];
+    int32_t n = near->start[k + 1] - near->start[k];
+    if (pushed) {
+        for (int32_t j = 0; j < n; ++j) clearance[j] = -1.0;
+        near->least_clearance[k] = -1.0;
+        return;
+    }
+    double *at = near->measured_at + 3 * (size_t)count * (size_t)k;
+    for (int p = 0; p < count; ++p) end_of(c, idx[p], at + 3 * p);
+    near->least_clearance[k] = least;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -421,73 +520,176 @@ static int32_t features_near(wc_feature_state *s, const wc_near_elements *near, 
     return n;
 }
 
-/* One pass of a collider against the cloth, from the cloth's side: each
- * cloth triangle near the collider asks the collider's vertex grid (built
- * once for a static collider) for the vertices near it, each cloth edge its
- * edge grid for the edges near it; for a static collider the near list
- * remembers the answers across steps. Returns 1 if anything moved, 0 if
- * not, -1 on out-of-memory. */
-static int collider_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col,
-                         const wc_near_list *near, double r, double mu, double dt)
+/* One cloth element's visit: what it needs to know about itself before
+ * its candidates are tested. */
+typedef struct element_visit {
+    const int32_t *idx; /* its particles */
+    int count;          /* 3 for a triangle, 2 for an edge */
+    double motion2;     /* largest squared motion of its particles */
+    double drift;       /* from where its clearances were measured */
+    double box[6];      /* over the step, grown by the largest contact distance */
+    double end[6];      /* at the end of the step, made when first needed */
+    int has_end;
+} element_visit;
+
+/* Whether the element must be visited at all: in a later pass only if a
+ * particle of it moved, and with a near list only if it has drifted as
+ * far as its least clearance or moves enough for continuous detection. */
+static int must_visit(const wc_cloth *c, const wc_feature_state *s, const wc_near_elements *near,
+                      int32_t k, double limit2, element_visit *v)
+{
+    if (s->only_moved) {
+        int any = 0;
+        for (int p = 0; p < v->count; ++p) any |= s->moved[v->idx[p]];
+        if (!any) return 0;
+    }
+    v->motion2 = element_motion2(c, v->idx, v->count);
+    v->has_end = 0;
+    v->drift = 0.0;
+    if (!near) return 1;
+    double least = near->least_clearance[k];
+    double d2 = drift2(c, near->measured_at + 3 * (size_t)v->count * (size_t)k, v->idx, v->count);
+    if (least > 0.0 && d2 < least * least && !(v->motion2 > limit2)) return 0;
+    v->drift = sqrt(d2);
+    return 1;
+}
+
+/* A candidate's clearance from the element's present ends when the pair
+ * needs no test: its last one less the drift since, while that is left
+ * (and no continuous detection is needed); else, when the boxes are apart
+ * (the pair cannot touch), from the boxes. Negative when the pair must be
+ * tested.
+ *
+ * A skipped pair is at least its clearance beyond r apart, and a contact
+ * needs it nearer than r sqrt(1 - SLACK), 0.5 % of r nearer still: far
+ * more than the rounding of the few operations behind a clearance, so
+ * skipping never misses a contact the test would have found. */
+static double untested_clearance(const wc_cloth *c, const wc_near_elements *near, int32_t k,
+                                 int32_t j, element_visit *v, const double *feature_box, int ccd,
+                                 double r)
+{
+    double last = near ? near->clearance[near->start[k] + j] : -1.0;
+    if (!ccd && last > v->drift) return last - v->drift;
+    if (wc_boxes_overlap(v->box, feature_box)) return -1.0;
+    if (!near) return 0.0;
+    if (!v->has_end) end_box(c, v->idx, v->count, v->end), v->has_end = 1;
+    return max2(0.0, box_gap(v->end, feature_box) - r);
+}
+
+/* Collider vertices against cloth triangles, or collider edges against
+ * cloth edges: what a pass over one kind of cloth element needs. */
+typedef struct element_kind {
+    int count;                  /* particles per element */
+    int feature_count;          /* collider vertices per feature */
+    const wc_grid *grid;        /* the collider's grid of these features */
+    const double *feature_boxes; /* their boxes, 6 per feature */
+    double ccd_limit2;          /* ccd_limit2 of the collider's contact distance */
+} element_kind;
+
+static element_kind triangles_of(const wc_collider *col, double r)
+{
+    element_kind kind = {3, 1, &col->vertex_grid, col->vertex_boxes, ccd_limit2(r)};
+    return kind;
+}
+
+static element_kind edges_of(const wc_collider *col, double r)
+{
+    element_kind kind = {2, 2, &col->edge_grid, col->edge_boxes, ccd_limit2(r)};
+    return kind;
+}
+
+/* Collider vertex indices of feature `id`. */
+static const int32_t *feature_vertices(const wc_collider *col, const element_kind *kind,
+                                       const int32_t *id)
+{
+    return kind->feature_count == 1 ? id : col->edges + 2 * (size_t)*id;
+}
+
+/* The exact test of cloth element `element` against a collider feature
+ * (its vertices `f`); as vertex_triangle and edge_edge. */
+static int test_pair(wc_cloth *c, wc_feature_state *s, const wc_collider *col,
+                     const element_kind *kind, int32_t element, const int32_t *f, int ccd,
+                     double r, double mu, double dt, double *d2)
+{
+    double p0[3], p1[3], q0[3], q1[3];
+    vertex_of(col->current, f[0], p0);
+    vertex_of(col->next, f[0], p1);
+    if (kind->feature_count == 1)
+        return vertex_triangle(c, s, element, p0, p1, ccd, r, mu, dt, d2);
+    vertex_of(col->current, f[1], q0);
+    vertex_of(col->next, f[1], q1);
+    return edge_edge(c, s, element, p0, p1, q0, q1, ccd, r, mu, dt, d2);
+}
+
+/* One kind of cloth element against the collider's features: each element
+ * near the collider asks the feature grid (or the near list) for the
+ * features near it and tests those it may touch. Returns 1 if anything
+ * moved, 0 if not, -1 on out-of-memory. */
+static int element_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col,
+                        wc_near_elements *near, const element_kind *kind, double r, double mu,
+                        double dt)
 {
     int moved = 0;
+    int32_t count = near ? near->count : kind->count == 3 ? s->triangle_count : s->edge_count;
+    const int32_t *particles = kind->count == 3 ? c->topology.triangles : s->edges;
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t element = near ? near->element[k] : k;
+        element_visit v;
+        v.idx = particles + (size_t)kind->count * (size_t)element, v.count = kind->count;
+        if (!must_visit(c, s, near, k, kind->ccd_limit2, &v)) continue;
+        /* triangles grow by the largest contact distance, as their near
+         * lists were made; edges by this collider's */
+        element_box(c, v.idx, v.count, kind->count == 3 ? s->r_max : r, v.box);
+        if (!wc_boxes_overlap(v.box, col->bounds)) continue;
+        const int32_t *found;
+        int32_t n = features_near(s, near, k, kind->grid, v.box, &found);
+        if (n < 0) return -1;
+        int pushed = 0;
+        double least = INFINITY;
+        for (int32_t j = 0; j < n; ++j) {
+            const int32_t *f = feature_vertices(col, kind, found + j);
+            int ccd = pair_needs_ccd(col, v.motion2, f, kind->feature_count, kind->ccd_limit2);
+            double clear = untested_clearance(c, near, k, j, &v,
+                                              kind->feature_boxes + 6 * (size_t)found[j], ccd, r);
+            if (clear < 0.0) {
+                double d2;
+                pushed |= test_pair(c, s, col, kind, element, f, ccd, r, mu, dt, &d2);
+                clear = sqrt(d2) - r;
+            }
+            if (near) near->clearance[near->start[k] + j] = clear;
+            least = min2(least, clear);
+        }
+        if (near) settle_clearances(c, near, k, v.idx, v.count, pushed, least);
+        moved |= pushed;
+    }
+    return moved;
+}
+
+/* One pass of a collider against the cloth, from the cloth's side: its
+ * vertices against the cloth's triangles, its edges against the cloth's
+ * edges; for a static collider the near list remembers the candidates
+ * (and their clearances) across steps. Returns 1 if anything moved, 0 if
+ * not, -1 on out-of-memory. */
+static int collider_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col,
+                         wc_near_list *near, double r, double mu, double dt)
+{
     if (!near) {
         /* every element is visited: first see whether the cloth is near at all */
         double bounds[6];
         cloth_bounds(c, s->r_max, bounds);
         if (!wc_boxes_overlap(col->bounds, bounds)) return 0;
     }
-    const wc_near_elements *tris = near ? &near->triangles : NULL, *edges = near ? &near->edges : NULL;
-    int32_t count = tris ? tris->count : s->triangle_count;
-    for (int32_t k = 0; k < count; ++k) {
-        int32_t t = tris ? tris->element[k] : k;
-        const int32_t *tri = c->topology.triangles + 3 * (size_t)t;
-        if (s->only_moved && !(s->moved[tri[0]] | s->moved[tri[1]] | s->moved[tri[2]])) continue;
-        double box[6];
-        triangle_box(c, tri, s->r_max, box);
-        if (!wc_boxes_overlap(box, col->bounds)) continue;
-        const int32_t *found;
-        int32_t n = features_near(s, tris, k, &col->vertex_grid, box, &found);
-        if (n < 0) return -1;
-        for (int32_t j = 0; j < n; ++j) {
-            double v0[3], v1[3];
-            if (tris && !wc_boxes_overlap(box, col->vertex_boxes + 6 * (size_t)found[j])) continue;
-            vertex_of(col->current, found[j], v0);
-            vertex_of(col->next, found[j], v1);
-            moved |= vertex_triangle(c, s, t, v0, v1, r, mu, dt);
-        }
-    }
-    count = edges ? edges->count : s->edge_count;
-    for (int32_t k = 0; k < count; ++k) {
-        int32_t e = edges ? edges->element[k] : k;
-        double a0[3], a1[3], b0[3], b1[3], box[6];
-        if (s->only_moved && !(s->moved[s->edges[2 * e]] | s->moved[s->edges[2 * e + 1]])) continue;
-        start_of(c, s->edges[2 * e], a0), end_of(c, s->edges[2 * e], a1);
-        start_of(c, s->edges[2 * e + 1], b0), end_of(c, s->edges[2 * e + 1], b1);
-        const double *ends[4] = {a0, a1, b0, b1};
-        feature_box(ends, 4, r, box);
-        if (!wc_boxes_overlap(box, col->bounds)) continue;
-        const int32_t *found;
-        int32_t n = features_near(s, edges, k, &col->edge_grid, box, &found);
-        if (n < 0) return -1;
-        for (int32_t j = 0; j < n; ++j) {
-            int32_t id = found[j];
-            if (edges && !wc_boxes_overlap(box, col->edge_boxes + 6 * (size_t)id)) continue;
-            double p0[3], p1[3], q0[3], q1[3];
-            vertex_of(col->current, col->edges[2 * id], p0);
-            vertex_of(col->next, col->edges[2 * id], p1);
-            vertex_of(col->current, col->edges[2 * id + 1], q0);
-            vertex_of(col->next, col->edges[2 * id + 1], q1);
-            moved |= edge_edge(c, s, e, p0, p1, q0, q1, r, mu, dt);
-        }
-    }
-    return moved;
+    element_kind triangles = triangles_of(col, r), edges = edges_of(col, r);
+    int moved = element_pass(c, s, col, near ? &near->triangles : NULL, &triangles, r, mu, dt);
+    if (moved < 0) return -1;
+    int edges_moved = element_pass(c, s, col, near ? &near->edges : NULL, &edges, r, mu, dt);
+    return edges_moved < 0 ? -1 : moved | edges_moved;
 }
 
 /* The near list of collider k, made to hold for this pass; NULL when the
  * collider moves (its grids are rebuilt every step, so there is nothing to
  * keep). -1 in *status on out-of-memory. */
-static const wc_near_list *near_list_for(wc_cloth *c, wc_feature_state *s, int32_t k,
+static wc_near_list *near_list_for(wc_cloth *c, wc_feature_state *s, int32_t k,
                                          const wc_collider *col, double r_triangles, double r,
                                          int *failed)
 {
@@ -510,7 +712,8 @@ static const wc_near_list *near_list_for(wc_cloth *c, wc_feature_state *s, int32
 }
 
 wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *const *colliders,
-                              int32_t count, double dt, wc_step_stats *stats, int *moved_out)
+                              int32_t count, double dt, int all, wc_step_stats *stats,
+                              int *moved_out)
 {
     *moved_out = 0;
     double h = c->material.thickness, r_max = 0.0;
@@ -519,9 +722,13 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
         if (colliders[k]->is_mesh) r_max = max2(r_max, h + colliders[k]->thickness), any = 1;
     if (!any) return WC_OK;
     s->r_max = r_max;
+    /* the first pass looks at what the particle pass moved as if a pass of
+     * its own had moved it */
+    if (!all) memcpy(s->moved, s->marks.shifted, (size_t)c->particle_count);
+    memset(s->marks.shifted, 0, (size_t)c->particle_count);
     int moved = 1;
     for (int pass = 0; pass < MAX_PASSES && moved; ++pass) {
-        s->only_moved = pass > 0;
+        s->only_moved = pass > 0 || !all;
         memset(s->moving, 0, (size_t)c->particle_count);
         moved = 0;
         for (int32_t k = 0; k < count; ++k) {
@@ -529,7 +736,7 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
             if (!col->is_mesh) continue;
             double r = fmax(h + col->thickness, 1e-6);
             int failed;
-            const wc_near_list *near = near_list_for(c, s, k, col, r_max, r, &failed);
+            wc_near_list *near = near_list_for(c, s, k, col, r_max, r, &failed);
             if (failed) return WC_ERROR_OUT_OF_MEMORY;
             int result = collider_pass(c, s, col, near, r, sqrt(c->material.friction * col->friction), dt);
             if (result < 0) return WC_ERROR_OUT_OF_MEMORY;
@@ -552,6 +759,7 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
         c->ny[i] = c->y[i] + carry[1], c->qy[i] = c->y[i];
         c->nz[i] = c->z[i] + carry[2], c->qz[i] = c->z[i];
         c->history_override[i] = 1;
+        s->marks.shifted[i] = 1;
         stats->failsafe_particles++;
     }
     return WC_OK;

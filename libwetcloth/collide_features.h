@@ -16,6 +16,7 @@
 #define WC_COLLIDE_FEATURES_H
 
 #include "cloth.h"
+#include "collide.h"
 #include "collider.h"
 
 /// Per-cloth buffers: the cloth's triangle edges, boxes, grid. Opaque.
@@ -35,12 +36,19 @@ void wc_feature_state_keep_near_lists(wc_feature_state *state, int keep);
 const struct wc_near_list *wc_feature_state_near_list(const wc_feature_state *state,
                                                      int32_t collider);
 
+/// The marks the particle pass and this pass leave each other between
+/// rounds (collide.h), kept here for the cloth.
+const wc_collide_marks *wc_feature_state_marks(const wc_feature_state *state);
+
 /// Resolves collider vertices and edges of every mesh collider against the
 /// cloth's motion from (x, y, z) to (nx, ny, nz). Serial and in a fixed
-/// order (collider, vertex, edge, candidate), so deterministic.
+/// order (collider, vertex, edge, candidate), so deterministic. Its first
+/// pass tests every triangle and edge if `all`, else only those with a
+/// particle marked in marks->shifted; it marks in marks->recheck each
+/// particle it moves and leaves its fail-safe particles in marks->shifted.
 /// *moved_out says whether it moved anything.
 wc_status wc_collide_features(wc_cloth *cloth, wc_feature_state *state,
                               wc_collider *const *colliders, int32_t collider_count, double dt,
-                              wc_step_stats *stats, int *moved_out);
+                              int all, wc_step_stats *stats, int *moved_out);
 
 #endif

@@ -20,6 +20,9 @@ static void elements_free(wc_near_elements *e)
     wc_free(e->element);
     wc_free(e->start);
     wc_free(e->found);
+    wc_free(e->measured_at);
+    wc_free(e->clearance);
+    wc_free(e->least_clearance);
     memset(e, 0, sizeof *e);
 }
 
@@ -87,6 +90,35 @@ static int reserve(int32_t **array, int64_t *capacity, int64_t need)
     wc_free(*array);
     *array = bigger, *capacity = grown;
     return 1;
+}
+
+/* Grows a double array to hold `need` items, contents not kept; 0 on
+ * out-of-memory. */
+static int reserve_doubles(double **array, int64_t *capacity, int64_t need)
+{
+    if (need <= *capacity) return 1;
+    int64_t grown = *capacity ? *capacity : 64;
+    while (grown < need) grown *= 2;
+    double *bigger = wc_alloc_array((size_t)grown, sizeof *bigger);
+    if (!bigger) return 0;
+    wc_free(*array);
+    *array = bigger, *capacity = grown;
+    return 1;
+}
+
+/* Room for the clearances of a freshly listed set, all unknown: the feature
+ * pass measures each element at its first visit. */
+static wc_status unknown_clearances(wc_near_elements *out, int per)
+{
+    int64_t found = out->start[out->count];
+    if (!reserve_doubles(&out->measured_at, &out->measured_capacity, 3 * (int64_t)per * out->count + 1) ||
+        !reserve_doubles(&out->clearance, &out->clearance_capacity, found + 1) ||
+        !reserve_doubles(&out->least_clearance, &out->least_capacity, (int64_t)out->count + 1))
+        return WC_ERROR_OUT_OF_MEMORY;
+    memset(out->measured_at, 0, (size_t)(3 * (int64_t)per * out->count) * sizeof *out->measured_at);
+    for (int64_t k = 0; k < found; ++k) out->clearance[k] = -1.0;
+    for (int32_t k = 0; k < out->count; ++k) out->least_clearance[k] = -1.0;
+    return WC_OK;
 }
 
 /* Query box of an element: its particles' boxes, grown by r. */
@@ -160,7 +192,9 @@ wc_status wc_near_list_build(wc_near_list *l, const wc_cloth *c, const int32_t *
     }
     wc_status s = list_elements(l, &l->triangles, c->topology.triangles, 3,
                                 c->topology.triangle_count, &col->vertex_grid, col->bounds, r_triangles);
+    if (!s) s = unknown_clearances(&l->triangles, 3);
     if (!s) s = list_elements(l, &l->edges, edges, 2, edge_count, &col->edge_grid, col->bounds, r_edges);
+    if (!s) s = unknown_clearances(&l->edges, 2);
     /* particle i is element i: the slot array is its own identity map */
     for (int32_t i = 0; i < n && !s; ++i) l->particle_slot[i] = i;
     if (!s) s = list_elements(l, &l->particles, l->particle_slot, 1, n, &col->grid, col->bounds, r_particles);

@@ -140,19 +140,21 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
         memcpy(cl->contact_prev, cl->contact, (size_t)cl->particle_count);
         memset(cl->contact, 0, (size_t)cl->particle_count);
         memset(cl->history_override, 0, (size_t)cl->particle_count);
+        if (w->collider_count && !cl->features && !(cl->features = wc_feature_state_create(cl)))
+            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                           "out of memory for the collision buffers of cloth %d; the world "
+                           "keeps its last good state", (int)c);
         /* Particles against collider faces, then collider vertices and edges
          * against the cloth's triangles and edges; the second can push a
          * particle back toward a face, so the two alternate until the
-         * second has nothing left to do. */
+         * second has nothing left to do. After the first round each looks
+         * only at what the other moved (collide.h). */
         for (int round = 0; round < 3 && w->collider_count; ++round) {
-            wc_collide_cloth(cl, w->colliders, w->collider_count, dt, threads, &w->stats);
-            if (!cl->features && !(cl->features = wc_feature_state_create(cl)))
-                return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
-                               "out of memory for the collision buffers of cloth %d; the world "
-                               "keeps its last good state", (int)c);
+            wc_collide_cloth(cl, w->colliders, w->collider_count, dt, threads, round == 0,
+                             wc_feature_state_marks(cl->features), &w->stats);
             int moved;
             if (wc_collide_features(cl, cl->features, w->colliders, w->collider_count, dt,
-                                    &w->stats, &moved))
+                                    round == 0, &w->stats, &moved))
                 return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                                "out of memory indexing cloth %d for collisions; the world keeps "
                                "its last good state", (int)c);
