@@ -106,14 +106,6 @@ double wc_buckling_energy(double d, double l, double R)
     return 2.0 * R * theta * theta / l;
 }
 
-double wc_buckling_force_ramped(double d, double l, double R)
-{
-    if (!(d < l)) return 0.0;
-    double gap = (l - d) / l;
-    if (gap >= WC_BUCKLING_ONSET_RAMP) return R / (l * l) * wc_buckling_phi_of_gap(gap);
-    return R / (l * l) * wc_buckling_phi_of_gap(WC_BUCKLING_ONSET_RAMP) * (gap / WC_BUCKLING_ONSET_RAMP);
-}
-
 double wc_buckling_energy_ramped(double d, double l, double R)
 {
     if (!(d < l)) return 0.0;

@@ -73,8 +73,15 @@ double wc_buckling_energy(double d, double l, double R);
 #define WC_BUCKLING_ONSET_RAMP 1e-3
 
 /// Force magnitude, N, as the simulation applies it: wc_buckling_force with
-/// the onset ramp (see WC_BUCKLING_ONSET_RAMP).
-double wc_buckling_force_ramped(double d, double l, double R);
+/// the onset ramp (see WC_BUCKLING_ONSET_RAMP). Inline: the force loop
+/// calls it for every compressed bend link of every step.
+static inline double wc_buckling_force_ramped(double d, double l, double R)
+{
+    if (!(d < l)) return 0.0;
+    double gap = (l - d) / l;
+    if (gap >= WC_BUCKLING_ONSET_RAMP) return R / (l * l) * wc_buckling_phi_of_gap(gap);
+    return R / (l * l) * wc_buckling_phi_of_gap(WC_BUCKLING_ONSET_RAMP) * (gap / WC_BUCKLING_ONSET_RAMP);
+}
 
 /// Energy whose gradient is wc_buckling_force_ramped, J.
 double wc_buckling_energy_ramped(double d, double l, double R);

@@ -161,8 +161,10 @@ struct wc_self_state {
     double *triangle_normals;
     /// Per patch: box (union of its particles' boxes), the same grown by h
     /// (the grid indexes those), cone axis, and a lower bound on the cosine
-    /// of the angle between the axis and any of its normals over the step.
-    double *patch_boxes, *patch_grown, *patch_axis, *patch_cos;
+    /// of the angle between the axis and any of its normals over the step;
+    /// for a patch within CONE_COS, the least cosine between its axis and
+    /// a joint axis that still holds it (cones_fit).
+    double *patch_boxes, *patch_grown, *patch_axis, *patch_cos, *patch_fit;
     /// Culling decisions of the current broadphase: the patch alone, and
     /// each adjacency entry (overlapping neighbours culled together).
     uint8_t *patch_culled, *adjacent_culled, *patch_touched;
@@ -561,13 +563,14 @@ wc_self_state *wc_self_state_create(const wc_cloth *c)
     s->patch_grown = wc_alloc_array(6 * np, sizeof *s->patch_grown);
     s->patch_axis = wc_alloc_array(3 * np, sizeof *s->patch_axis);
     s->patch_cos = wc_alloc_array(np, sizeof *s->patch_cos);
+    s->patch_fit = wc_alloc_array(np, sizeof *s->patch_fit);
     s->patch_culled = wc_alloc_array(np, 1);
     s->patch_touched = wc_alloc_array(np, 1);
     s->adjacent_culled = wc_alloc_array(adjacency, 1);
     s->dirty = wc_alloc_array(n, 1);
     s->reverted = wc_alloc_array(n, 1);
     if (!s->particle_boxes || !s->triangle_boxes || !s->edge_boxes || !s->triangle_normals ||
-        !s->patch_boxes || !s->patch_grown || !s->patch_axis || !s->patch_cos ||
+        !s->patch_boxes || !s->patch_grown || !s->patch_axis || !s->patch_cos || !s->patch_fit ||
         !s->patch_culled || !s->patch_touched || !s->adjacent_culled || !s->dirty || !s->reverted ||
         !s->rest_triangle_boxes || !s->rest_edge_boxes) {
         wc_self_state_destroy(s);
@@ -596,7 +599,7 @@ void wc_self_state_destroy(wc_self_state *s)
     void *blocks[] = {s->edges, s->edge_owner, s->rest, s->rest_triangle_boxes,
                       s->rest_edge_boxes, s->triangle_patch,
                       s->particle_boxes, s->triangle_boxes, s->edge_boxes, s->triangle_normals,
-                      s->patch_boxes, s->patch_grown, s->patch_axis, s->patch_cos,
+                      s->patch_boxes, s->patch_grown, s->patch_axis, s->patch_cos, s->patch_fit,
                       s->patch_culled, s->adjacent_culled, s->patch_touched, s->open, s->joined, s->vf,
                       s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted, s->vf_h};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
@@ -680,6 +683,11 @@ static void patch_cone(wc_self_state *s, int32_t p)
             cosine = min2(cosine, triangle_cos(s->triangle_normals + 9 * (size_t)tris->items[k], axis));
     }
     s->patch_cos[p] = cosine;
+    /* cones_fit asks acos(cosine) + acos(c) < acos(CONE_COS) of the angle
+     * c to a joint axis: acos falls, so that is c > cos(acos(CONE_COS) -
+     * acos(cosine)), one comparison with this instead of two arc cosines
+     * per patch and check (the angle difference lies in [0, 60 degrees]) */
+    if (cosine > CONE_COS) s->patch_fit[p] = cos(acos(CONE_COS) - acos(cosine));
 }
 
 /* Whether the cones of `count` patches fit in one cone of half-angle
@@ -694,11 +702,8 @@ static int cones_fit(const wc_self_state *s, const int32_t *patches, int count)
         for (int m = 0; m < 3; ++m) d[m] += s->patch_axis[3 * (size_t)patches[k] + m];
     }
     if (!normalize3(d)) return 0;
-    for (int k = 0; k < count; ++k) {
-        double c = dot3(s->patch_axis + 3 * (size_t)patches[k], d);
-        c = c > 1.0 ? 1.0 : c < -1.0 ? -1.0 : c;
-        if (!(acos(s->patch_cos[patches[k]]) + acos(c) < acos(CONE_COS))) return 0;
-    }
+    for (int k = 0; k < count; ++k)
+        if (!(dot3(s->patch_axis + 3 * (size_t)patches[k], d) > s->patch_fit[patches[k]])) return 0;
     return 1;
 }
 
@@ -1486,7 +1491,10 @@ static int still_valid(wc_self_state *s, const wc_cloth *c, int threads)
         if (!s->patch_touched[p]) continue;
         if (s->patch_culled[p] && !(s->patch_cos[p] > CONE_COS)) return 0;
         for (int32_t k = adj->start[p]; k < adj->start[p + 1]; ++k) {
-            int32_t two[2] = {p, adj->items[k]};
+            /* both entries of a pair are flagged: check it from one side,
+             * from the other when that one was not touched */
+            int32_t q = adj->items[k], two[2] = {p, q};
+            if (q < p && s->patch_touched[q]) continue;
             if (s->adjacent_culled[k] && !cones_fit(s, two, 2)) return 0;
         }
     }
