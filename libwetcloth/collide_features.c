@@ -42,6 +42,13 @@ struct wc_feature_state {
     /// Between rounds (collide.h): recheck for the particle pass, shifted
     /// for the first pass of the next call.
     wc_collide_marks marks;
+    /// Per particle: the length of the path its end of step has taken
+    /// (clearances, near_list.h), the end it was last brought up to, and
+    /// its squared motion over the step; kept up to date through the
+    /// passes, so an element's visit reads them instead of positions.
+    double *path;
+    double *path_end;
+    double *motion2;
     /// Candidate collider features of one cloth element.
     int32_t *found;
     int32_t found_capacity;
@@ -122,10 +129,14 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
     s->carry = wc_alloc_array(3 * (size_t)c->particle_count, sizeof *s->carry);
     s->marks.recheck = wc_alloc_array((size_t)c->particle_count, sizeof *s->marks.recheck);
     s->marks.shifted = wc_alloc_array((size_t)c->particle_count, sizeof *s->marks.shifted);
+    s->path = wc_alloc_array((size_t)c->particle_count, sizeof *s->path);
+    s->path_end = wc_alloc_array(3 * (size_t)c->particle_count, sizeof *s->path_end);
+    s->motion2 = wc_alloc_array((size_t)c->particle_count, sizeof *s->motion2);
     s->found_capacity = 256;
     s->found = wc_alloc_array((size_t)s->found_capacity, sizeof *s->found);
     if (!entries || !s->edges || !s->triangle_edges || !s->moved || !s->moving ||
-        !s->carry || !s->marks.recheck || !s->marks.shifted || !s->found) {
+        !s->carry || !s->marks.recheck || !s->marks.shifted || !s->path || !s->path_end ||
+        !s->motion2 || !s->found) {
         wc_free(entries);
         wc_feature_state_destroy(s);
         return NULL;
@@ -171,6 +182,9 @@ void wc_feature_state_destroy(wc_feature_state *s)
     wc_free(s->carry);
     wc_free(s->marks.recheck);
     wc_free(s->marks.shifted);
+    wc_free(s->path);
+    wc_free(s->path_end);
+    wc_free(s->motion2);
     wc_free(s->found);
     for (int32_t k = 0; k < s->near_count; ++k) wc_near_list_free(&s->near[k]);
     wc_free(s->near);
@@ -228,6 +242,20 @@ static void velocity_of(const wc_cloth *c, int32_t i, double dt, double v[3])
     for (int k = 0; k < 3; ++k) v[k] = (e[k] - from[k]) / dt;
 }
 
+/* Brings particle i's path and motion up to its end of step as it is now. */
+static void track_particle(const wc_cloth *c, wc_feature_state *s, int32_t i)
+{
+    double *last = s->path_end + 3 * (size_t)i, end[3], d[3];
+    end_of(c, i, end);
+    for (int k = 0; k < 3; ++k) d[k] = end[k] - last[k], last[k] = end[k];
+    double step2 = dot3(d, d);
+    if (step2 > 0.0) s->path[i] += sqrt(step2);
+    double start[3];
+    start_of(c, i, start);
+    for (int k = 0; k < 3; ++k) d[k] = end[k] - start[k];
+    s->motion2[i] = dot3(d, d);
+}
+
 /* A cloth element (count particles with barycentric weights w) is at signed
  * distance `gap` from a collider feature along n (pointing from the feature
  * to the cloth); the feature moves at v_feature. Moves the element out to
@@ -276,6 +304,7 @@ static int push_element(wc_cloth *c, wc_feature_state *s, const int32_t *idx, co
         c->nx[i] += share * depth * n[0];
         c->ny[i] += share * depth * n[1];
         c->nz[i] += share * depth * n[2];
+        track_particle(c, s, i);
         for (int d = 0; d < 3; ++d) v[k][d] += share * change[d];
         c->qx[i] = c->nx[i] - v[k][0] * dt;
         c->qy[i] = c->ny[i] - v[k][1] * dt;
@@ -293,14 +322,10 @@ static int push_element(wc_cloth *c, wc_feature_state *s, const int32_t *idx, co
 }
 
 /* Largest squared displacement over the step of the given particles. */
-static double element_motion2(const wc_cloth *c, const int32_t *idx, int count)
+static double element_motion2(const wc_feature_state *s, const int32_t *idx, int count)
 {
     double m = 0.0;
-    for (int k = 0; k < count; ++k) {
-        int32_t i = idx[k];
-        double d[3] = {c->nx[i] - c->x[i], c->ny[i] - c->y[i], c->nz[i] - c->z[i]};
-        m = max2(m, dot3(d, d));
-    }
+    for (int k = 0; k < count; ++k) m = max2(m, s->motion2[idx[k]]);
     return m;
 }
 
@@ -431,17 +456,12 @@ static int edge_edge(wc_cloth *c, wc_feature_state *s, int32_t e, const double p
 /* Clearances (near_list.h)                                                 */
 /* ------------------------------------------------------------------------ */
 
-/* How far the element's particles (their ends) have gone at most from
- * where its clearances were measured, squared. */
-static double drift2(const wc_cloth *c, const double *measured_at, const int32_t *idx, int count)
+/* How far the element's particles (their ends) have gone at most since
+ * its clearances were measured: the longest path since. */
+static double drift(const wc_feature_state *s, const double *path_at, const int32_t *idx, int count)
 {
     double m = 0.0;
-    for (int k = 0; k < count; ++k) {
-        const double *at = measured_at + 3 * k;
-        int32_t i = idx[k];
-        double d[3] = {c->nx[i] - at[0], c->ny[i] - at[1], c->nz[i] - at[2]};
-        m = max2(m, dot3(d, d));
-    }
+    for (int k = 0; k < count; ++k) m = max2(m, s->path[idx[k]] - path_at[k]);
     return m;
 }
 
@@ -471,7 +491,7 @@ static void end_box(const wc_cloth *c, const int32_t *idx, int count, double box
 /* After a visit of near-list element k: its clearances were measured at
  * the particles' present ends, unless a push moved them part-way through
  * the candidates, which leaves them unknown until the next visit. */
-static void settle_clearances(const wc_cloth *c, wc_near_elements *near, int32_t k,
+static void settle_clearances(const wc_feature_state *s, wc_near_elements *near, int32_t k,
                               const int32_t *idx, int count, int pushed, double least)
 {
     double *clearance = near->clearance + near->start[k];
@@ -481,8 +501,8 @@ static void settle_clearances(const wc_cloth *c, wc_near_elements *near, int32_t
         near->least_clearance[k] = -1.0;
         return;
     }
-    double *at = near->measured_at + 3 * (size_t)count * (size_t)k;
-    for (int p = 0; p < count; ++p) end_of(c, idx[p], at + 3 * p);
+    double *at = near->path_at + (size_t)count * (size_t)k;
+    for (int p = 0; p < count; ++p) at[p] = s->path[idx[p]];
     near->least_clearance[k] = least;
 }
 
@@ -535,23 +555,20 @@ typedef struct element_visit {
 /* Whether the element must be visited at all: in a later pass only if a
  * particle of it moved, and with a near list only if it has drifted as
  * far as its least clearance or moves enough for continuous detection. */
-static int must_visit(const wc_cloth *c, const wc_feature_state *s, const wc_near_elements *near,
-                      int32_t k, double limit2, element_visit *v)
+static int must_visit(const wc_feature_state *s, const wc_near_elements *near, int32_t k,
+                      double limit2, element_visit *v)
 {
     if (s->only_moved) {
         int any = 0;
         for (int p = 0; p < v->count; ++p) any |= s->moved[v->idx[p]];
         if (!any) return 0;
     }
-    v->motion2 = element_motion2(c, v->idx, v->count);
+    v->motion2 = element_motion2(s, v->idx, v->count);
     v->has_end = 0;
     v->drift = 0.0;
     if (!near) return 1;
-    double least = near->least_clearance[k];
-    double d2 = drift2(c, near->measured_at + 3 * (size_t)v->count * (size_t)k, v->idx, v->count);
-    if (least > 0.0 && d2 < least * least && !(v->motion2 > limit2)) return 0;
-    v->drift = sqrt(d2);
-    return 1;
+    v->drift = drift(s, near->path_at + (size_t)v->count * (size_t)k, v->idx, v->count);
+    return v->motion2 > limit2 || !(v->drift < near->least_clearance[k]);
 }
 
 /* A candidate's clearance from the element's present ends when the pair
@@ -636,7 +653,7 @@ static int element_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col
         int32_t element = near ? near->element[k] : k;
         element_visit v;
         v.idx = particles + (size_t)kind->count * (size_t)element, v.count = kind->count;
-        if (!must_visit(c, s, near, k, kind->ccd_limit2, &v)) continue;
+        if (!must_visit(s, near, k, kind->ccd_limit2, &v)) continue;
         /* triangles grow by the largest contact distance, as their near
          * lists were made; edges by this collider's */
         element_box(c, v.idx, v.count, kind->count == 3 ? s->r_max : r, v.box);
@@ -659,7 +676,7 @@ static int element_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col
             if (near) near->clearance[near->start[k] + j] = clear;
             least = min2(least, clear);
         }
-        if (near) settle_clearances(c, near, k, v.idx, v.count, pushed, least);
+        if (near) settle_clearances(s, near, k, v.idx, v.count, pushed, least);
         moved |= pushed;
     }
     return moved;
@@ -726,6 +743,9 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
      * its own had moved it */
     if (!all) memcpy(s->moved, s->marks.shifted, (size_t)c->particle_count);
     memset(s->marks.shifted, 0, (size_t)c->particle_count);
+    /* whatever moved the particles since the last call (integration, the
+     * particle pass, self-collision, a fail-safe) goes into their paths */
+    for (int32_t i = 0; i < c->particle_count; ++i) track_particle(c, s, i);
     int moved = 1;
     for (int pass = 0; pass < MAX_PASSES && moved; ++pass) {
         s->only_moved = pass > 0 || !all;

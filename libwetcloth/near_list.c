@@ -20,7 +20,7 @@ static void elements_free(wc_near_elements *e)
     wc_free(e->element);
     wc_free(e->start);
     wc_free(e->found);
-    wc_free(e->measured_at);
+    wc_free(e->path_at);
     wc_free(e->clearance);
     wc_free(e->least_clearance);
     memset(e, 0, sizeof *e);
@@ -111,11 +111,11 @@ static int reserve_doubles(double **array, int64_t *capacity, int64_t need)
 static wc_status unknown_clearances(wc_near_elements *out, int per)
 {
     int64_t found = out->start[out->count];
-    if (!reserve_doubles(&out->measured_at, &out->measured_capacity, 3 * (int64_t)per * out->count + 1) ||
+    if (!reserve_doubles(&out->path_at, &out->path_at_capacity, (int64_t)per * out->count + 1) ||
         !reserve_doubles(&out->clearance, &out->clearance_capacity, found + 1) ||
         !reserve_doubles(&out->least_clearance, &out->least_capacity, (int64_t)out->count + 1))
         return WC_ERROR_OUT_OF_MEMORY;
-    memset(out->measured_at, 0, (size_t)(3 * (int64_t)per * out->count) * sizeof *out->measured_at);
+    memset(out->path_at, 0, (size_t)((int64_t)per * out->count) * sizeof *out->path_at);
     for (int64_t k = 0; k < found; ++k) out->clearance[k] = -1.0;
     for (int32_t k = 0; k < out->count; ++k) out->least_clearance[k] = -1.0;
     return WC_OK;

@@ -24,13 +24,14 @@
 /// element k: found[start[k] .. start[k+1]), ascending.
 ///
 /// Clearances (kept by the feature pass, collide_features.c): the element's
-/// particles may drift this far from where they were when measured before
-/// a candidate could come within the contact distance. A cloth resting on
-/// a collider stays near the same features step after step and moves a
-/// tiny part of its clearance, so most pairs need no distance computed:
-/// the distance between a collider feature and a cloth element changes by
-/// no more than the farthest its particles move (every point of the
-/// element is a weighted mean of them).
+/// particles may go this far from where they were when measured before a
+/// candidate could come within the contact distance. A cloth resting on a
+/// collider stays near the same features step after step and moves a tiny
+/// part of its clearance, so most pairs need no distance computed: the
+/// distance between a collider feature and a cloth element changes by no
+/// more than the farthest its particles move (every point of the element
+/// is a weighted mean of them), and a particle moves no farther than the
+/// length of its path (which the feature pass keeps per particle).
 typedef struct wc_near_elements {
     int32_t count;
     int32_t *element;
@@ -39,14 +40,14 @@ typedef struct wc_near_elements {
     int64_t element_capacity;
     int64_t start_capacity;
     int64_t found_capacity;
-    /// Per element, xyz per particle: the end-of-step positions its
-    /// clearances were measured at.
-    double *measured_at;
+    /// Per element, per particle: the length of the particle's path when
+    /// the element's clearances were measured.
+    double *path_at;
     /// Per candidate (as found): its clearance, m; negative when unknown.
     double *clearance;
     /// Per element: the least clearance of its candidates.
     double *least_clearance;
-    int64_t measured_capacity;
+    int64_t path_at_capacity;
     int64_t clearance_capacity;
     int64_t least_capacity;
 } wc_near_elements;
