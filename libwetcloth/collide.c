@@ -18,6 +18,9 @@
 /* Candidate triangles a particle keeps on the stack; more than this (a
  * collider far finer than the cloth) falls back to testing every triangle. */
 #define MAX_CANDIDATES 256
+/* A particle skips a collider while its clearance exceeds its drift by
+ * this fraction of the contact distance: far more than rounding. */
+#define CLEARANCE_MARGIN 1e-6
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
@@ -154,18 +157,27 @@ typedef struct particle_motion {
      * sustained contact (touching in the last step too), else 1 */
     double wet_keep;
     int touched;
+    /* where the velocity so far is measured from (the history override if
+     * an earlier response this step set one); the velocity itself is made
+     * at the first response, as most particles get none */
+    double from[3];
+    int has_velocity;
 } particle_motion;
 
 /* The response to one contact (thesis eq. 2.7, corrected): with the surface
  * point moving at v_surface and the normal n toward the particle, remove the
  * approaching normal part of the relative velocity and let Coulomb friction
- * take at most mu times that change off the tangential part. The same
+ * take at most mu times that change off the tangential part (mu is the
+ * square root of `friction`, the product of the two coefficients). The same
  * tangential reduction is applied to this step's displacement, so a
  * particle held by friction does not slide during the step either. */
 static void respond(particle_motion *m, const double surface[3], const double n[3],
-                    const double v_surface[3], double r, double mu, double wet_keep, double dt)
+                    const double v_surface[3], double r, double friction, double wet_keep, double dt)
 {
-    double rel[3], vn, tangent[3], speed_t;
+    double rel[3], vn, tangent[3], speed_t, mu = sqrt(friction);
+    if (!m->has_velocity)
+        for (int k = 0; k < 3; ++k) m->vel[k] = (m->end[k] - m->from[k]) / dt;
+    m->has_velocity = 1;
     for (int k = 0; k < 3; ++k) {
         m->end[k] = surface[k] + n[k] * r;
         rel[k] = m->vel[k] - v_surface[k];
@@ -216,7 +228,7 @@ static int crosses_static(const particle_motion *m, double t0[3][3], const doubl
 }
 
 /* Tests one collider triangle; returns 1 when it moved the particle. */
-static int mesh_triangle(particle_motion *m, const wc_collider *c, int32_t t, double r, double mu,
+static int mesh_triangle(particle_motion *m, const wc_collider *c, int32_t t, double r, double friction,
                          double dt)
 {
     const double *n0 = c->normal_current + 3 * (size_t)t, *n1 = c->normal_next + 3 * (size_t)t;
@@ -266,7 +278,7 @@ static int mesh_triangle(particle_motion *m, const wc_collider *c, int32_t t, do
     double p0[3], v_surface[3];
     bary_point(t0[0], t0[1], t0[2], w, p0);
     for (int k = 0; k < 3; ++k) v_surface[k] = (cp[k] - p0[k]) / dt;
-    respond(m, cp, n, v_surface, r, mu, m->wet_keep, dt);
+    respond(m, cp, n, v_surface, r, friction, m->wet_keep, dt);
     return 1;
 }
 
@@ -314,17 +326,72 @@ static void query_candidates(candidates *cand, const particle_motion *m, const w
                       : 0;
 }
 
-static int mesh_collider(particle_motion *m, const wc_collider *c, const wc_near_list *near,
-                         int32_t particle, candidates *cand, double r, double mu, double dt)
+/* A lower bound, less r, on the distance from the particle's end to every
+ * triangle in `listed`: for each the larger of its distance to the
+ * triangle's plane and to the triangle's box, both no more than its
+ * distance to the triangle. Degenerate triangles are never tested. */
+static double particle_clearance(const particle_motion *m, const wc_collider *c,
+                                 const int32_t *listed, int32_t count, double r)
 {
+    double least = INFINITY;
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t t = listed[k];
+        const double *n = c->normal_current + 3 * (size_t)t, *box = c->boxes + 6 * (size_t)t;
+        if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) continue;
+        const double *a = c->current + 3 * (size_t)c->triangles[3 * (size_t)t];
+        double plane = fabs((m->end[0] - a[0]) * n[0] + (m->end[1] - a[1]) * n[1] + (m->end[2] - a[2]) * n[2]);
+        double gap2 = 0.0;
+        for (int j = 0; j < 3; ++j) {
+            double below = box[j] - m->end[j], above = m->end[j] - box[j + 3];
+            if (below > 0.0) gap2 += below * below;
+            else if (above > 0.0) gap2 += above * above;
+        }
+        double distance = sqrt(gap2);
+        if (plane > distance) distance = plane;
+        if (distance < least) least = distance;
+    }
+    return least - r;
+}
+
+/* The particle's slot in the near list's particle part when the list
+ * holds for its motion and gives it candidates, else -1. */
+static int32_t near_slot(const wc_near_list *near, const particle_motion *m, const wc_collider *c,
+                         int32_t particle, double r, const int32_t **listed, int32_t *count)
+{
+    if (!near || !wc_near_list_particle(near, c, 2 * r, particle, m->start[0], m->start[1],
+                                        m->start[2], m->end[0], m->end[1], m->end[2], listed, count))
+        return -1;
+    return near->particle_slot[particle];
+}
+
+/* One mesh collider against one particle. In the first test of a particle
+ * nothing has moved yet this round, a static collider's near list keeps
+ * the particle's clearance (near_list.h): while its start and end stay
+ * within it of where it was measured, nothing can touch and the tests are
+ * skipped; else they run, and if they move nothing it is measured anew.
+ * A contact needs the particle within r; the margin covers rounding. */
+static int mesh_collider(particle_motion *m, const wc_collider *c, wc_near_list *near,
+                         const wc_feature_state *fs, int first, int32_t particle,
+                         candidates *cand, double r, double friction, double dt)
+{
+    const int32_t *listed = NULL;
+    int32_t count = 0, slot = first && fs ? near_slot(near, m, c, particle, r, &listed, &count) : -1;
+    wc_near_elements *kept = near ? &near->particles : NULL;
+    if (slot >= 0 && wc_feature_state_drift(fs, particle, kept->path_at[slot]) + CLEARANCE_MARGIN * r <
+                         kept->least_clearance[slot])
+        return 0;
     query_candidates(cand, m, c, near, particle, r);
     int moved = 0;
     if (cand->count <= MAX_CANDIDATES) {
-        for (int32_t k = 0; k < cand->count; ++k) moved |= mesh_triangle(m, c, cand->found[k], r, mu, dt);
+        for (int32_t k = 0; k < cand->count; ++k) moved |= mesh_triangle(m, c, cand->found[k], r, friction, dt);
     } else {
         /* more candidates than the buffer holds: test every triangle */
         for (int32_t t = 0; t < c->triangle_count; ++t)
-            if (wc_boxes_overlap(cand->box, c->boxes + 6 * (size_t)t)) moved |= mesh_triangle(m, c, t, r, mu, dt);
+            if (wc_boxes_overlap(cand->box, c->boxes + 6 * (size_t)t)) moved |= mesh_triangle(m, c, t, r, friction, dt);
+    }
+    if (slot >= 0) {
+        kept->least_clearance[slot] = moved ? -1.0 : particle_clearance(m, c, listed, count, r);
+        kept->path_at[slot] = wc_feature_state_path(fs, particle);
     }
     return moved;
 }
@@ -332,7 +399,8 @@ static int mesh_collider(particle_motion *m, const wc_collider *c, const wc_near
 /* Convex shapes move rigidly: the particle's motion is taken into the
  * shape's frame (start in the pose at the start of the step, end in the pose
  * at its end), where the shape stands still. */
-static int convex_collider(particle_motion *m, const wc_collider *c, double r, double mu, double dt)
+static int convex_collider(particle_motion *m, const wc_collider *c, double r, double friction,
+                           double dt)
 {
     double box[6];
     empty_box(box);
@@ -350,7 +418,7 @@ static int convex_collider(particle_motion *m, const wc_collider *c, double r, d
     wc_pose_to_world(&c->pose_next, out, surface);
     wc_pose_to_world(&c->pose_current, out, before);
     for (int k = 0; k < 3; ++k) v_surface[k] = (surface[k] - before[k]) / dt;
-    respond(m, surface, n, v_surface, r, mu, m->wet_keep, dt);
+    respond(m, surface, n, v_surface, r, friction, m->wet_keep, dt);
     return 1;
 }
 
@@ -371,9 +439,9 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
         m.end[0] = cl->nx[i], m.end[1] = cl->ny[i], m.end[2] = cl->nz[i];
         /* the velocity so far: through the history override if an earlier
          * response this step already set one */
-        double from[3] = {m.start[0], m.start[1], m.start[2]};
-        if (cl->history_override[i]) from[0] = cl->qx[i], from[1] = cl->qy[i], from[2] = cl->qz[i];
-        for (int k = 0; k < 3; ++k) m.vel[k] = (m.end[k] - from[k]) / dt;
+        for (int k = 0; k < 3; ++k) m.from[k] = m.start[k];
+        if (cl->history_override[i]) m.from[0] = cl->qx[i], m.from[1] = cl->qy[i], m.from[2] = cl->qz[i];
+        m.has_velocity = 0;
         m.touched = 0;
         m.wet_keep = cl->contact_prev[i] != WC_CONTACT_NONE
                          ? 1.0 - cl->wetness[i] * (1.0 - cl->material.wet_friction)
@@ -387,14 +455,18 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
             moved = 0;
             for (int32_t c = 0; c < count; ++c) {
                 const wc_collider *col = colliders[c];
-                double r = fmax(h + col->thickness, MIN_CONTACT_DISTANCE);
-                double mu = sqrt(mu_cloth * col->friction);
+                double r = h + col->thickness;
+                if (r < MIN_CONTACT_DISTANCE) r = MIN_CONTACT_DISTANCE;
+                /* the contact's mu is its square root, taken only for a
+                 * response */
+                double friction = mu_cloth * col->friction;
                 if (col->is_mesh) {
                     if (cand_owner != c) cand.count = -1, cand_owner = c;
-                    moved |= mesh_collider(&m, col, wc_feature_state_near_list(cl->features, c), i,
-                                           &cand, r, mu, dt);
+                    moved |= mesh_collider(&m, col, wc_feature_state_near_list(cl->features, c),
+                                           cl->features, pass == 0 && !m.touched, i, &cand, r,
+                                           friction, dt);
                 } else {
-                    moved |= convex_collider(&m, col, r, mu, dt);
+                    moved |= convex_collider(&m, col, r, friction, dt);
                 }
             }
         }
@@ -413,6 +485,7 @@ void wc_collide_cloth(wc_cloth *cl, wc_collider *const *colliders, int32_t count
         }
         marks->shifted[i] = 1;
         cl->nx[i] = m.end[0], cl->ny[i] = m.end[1], cl->nz[i] = m.end[2];
+        if (cl->features) wc_feature_state_track(cl->features, cl, i);
         cl->qx[i] = m.end[0] - m.vel[0] * dt;
         cl->qy[i] = m.end[1] - m.vel[1] * dt;
         cl->qz[i] = m.end[2] - m.vel[2] * dt;

@@ -49,6 +49,8 @@ struct wc_feature_state {
     double *path;
     double *path_end;
     double *motion2;
+    /// Per particle: its path length at its start of step.
+    double *path_start;
     /// Candidate collider features of one cloth element.
     int32_t *found;
     int32_t found_capacity;
@@ -132,11 +134,12 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
     s->path = wc_alloc_array((size_t)c->particle_count, sizeof *s->path);
     s->path_end = wc_alloc_array(3 * (size_t)c->particle_count, sizeof *s->path_end);
     s->motion2 = wc_alloc_array((size_t)c->particle_count, sizeof *s->motion2);
+    s->path_start = wc_alloc_array((size_t)c->particle_count, sizeof *s->path_start);
     s->found_capacity = 256;
     s->found = wc_alloc_array((size_t)s->found_capacity, sizeof *s->found);
     if (!entries || !s->edges || !s->triangle_edges || !s->moved || !s->moving ||
         !s->carry || !s->marks.recheck || !s->marks.shifted || !s->path || !s->path_end ||
-        !s->motion2 || !s->found) {
+        !s->motion2 || !s->path_start || !s->found) {
         wc_free(entries);
         wc_feature_state_destroy(s);
         return NULL;
@@ -166,7 +169,7 @@ void wc_feature_state_keep_near_lists(wc_feature_state *s, int keep) { s->skip_n
 
 const wc_collide_marks *wc_feature_state_marks(const wc_feature_state *s) { return &s->marks; }
 
-const wc_near_list *wc_feature_state_near_list(const wc_feature_state *s, int32_t collider)
+wc_near_list *wc_feature_state_near_list(wc_feature_state *s, int32_t collider)
 {
     if (!s || s->skip_near_lists || collider >= s->near_count) return NULL;
     return &s->near[collider];
@@ -185,6 +188,7 @@ void wc_feature_state_destroy(wc_feature_state *s)
     wc_free(s->path);
     wc_free(s->path_end);
     wc_free(s->motion2);
+    wc_free(s->path_start);
     wc_free(s->found);
     for (int32_t k = 0; k < s->near_count; ++k) wc_near_list_free(&s->near[k]);
     wc_free(s->near);
@@ -254,6 +258,35 @@ static void track_particle(const wc_cloth *c, wc_feature_state *s, int32_t i)
     start_of(c, i, start);
     for (int k = 0; k < 3; ++k) d[k] = end[k] - start[k];
     s->motion2[i] = dot3(d, d);
+}
+
+void wc_feature_state_track(wc_feature_state *s, const wc_cloth *c, int32_t i)
+{
+    track_particle(c, s, i);
+}
+
+void wc_feature_state_begin_step(wc_feature_state *s, const wc_cloth *c)
+{
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        /* the start is where the end was committed, after whatever moved it
+         * since it was last tracked (self-collision, wet contacts) */
+        double *last = s->path_end + 3 * (size_t)i, start[3], d[3];
+        start_of(c, i, start);
+        for (int k = 0; k < 3; ++k) d[k] = start[k] - last[k], last[k] = start[k];
+        double step2 = dot3(d, d);
+        if (step2 > 0.0) s->path[i] += sqrt(step2);
+        s->path_start[i] = s->path[i];
+        track_particle(c, s, i);
+    }
+}
+
+double wc_feature_state_path(const wc_feature_state *s, int32_t i) { return s->path[i]; }
+
+double wc_feature_state_drift(const wc_feature_state *s, int32_t i, double path_at)
+{
+    /* the end is on the path after path_at; the start after it too when
+     * path_at is from an earlier step, else before it */
+    return max2(s->path[i] - path_at, path_at - s->path_start[i]);
 }
 
 /* A cloth element (count particles with barycentric weights w) is at signed
@@ -722,7 +755,10 @@ static wc_near_list *near_list_for(wc_cloth *c, wc_feature_state *s, int32_t k,
     }
     wc_near_list *l = &s->near[k];
     /* the particle pass grows its query boxes by twice the contact distance */
-    if (wc_near_list_holds(l, c, col, r_triangles, r, 2 * r)) return l;
+    /* in a pass after the first only the particles that pass marked moved
+     * can have left their boxes since the list was last found to hold */
+    if (wc_near_list_holds(l, c, col, r_triangles, r, 2 * r, s->only_moved ? s->moved : NULL))
+        return l;
     if (wc_near_list_build(l, c, s->edges, s->edge_count, col, r_triangles, r, 2 * r))
         return *failed = 1, NULL;
     return l;
@@ -743,9 +779,8 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
      * its own had moved it */
     if (!all) memcpy(s->moved, s->marks.shifted, (size_t)c->particle_count);
     memset(s->marks.shifted, 0, (size_t)c->particle_count);
-    /* whatever moved the particles since the last call (integration, the
-     * particle pass, self-collision, a fail-safe) goes into their paths */
-    for (int32_t i = 0; i < c->particle_count; ++i) track_particle(c, s, i);
+    /* the particles' paths are up to date: wc_feature_state_begin_step
+     * started them for this step, and every move since was tracked */
     int moved = 1;
     for (int pass = 0; pass < MAX_PASSES && moved; ++pass) {
         s->only_moved = pass > 0 || !all;
@@ -780,6 +815,7 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
         c->nz[i] = c->z[i] + carry[2], c->qz[i] = c->z[i];
         c->history_override[i] = 1;
         s->marks.shifted[i] = 1;
+        track_particle(c, s, i);
         stats->failsafe_particles++;
     }
     return WC_OK;

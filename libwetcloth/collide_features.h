@@ -32,9 +32,21 @@ void wc_feature_state_destroy(wc_feature_state *state);
 void wc_feature_state_keep_near_lists(wc_feature_state *state, int keep);
 
 /// The near list kept for collider `collider` (by index), or NULL if there
-/// is none; the particle pass (collide.c) reads its particle part.
-const struct wc_near_list *wc_feature_state_near_list(const wc_feature_state *state,
-                                                     int32_t collider);
+/// is none; the particle pass (collide.c) uses its particle part.
+struct wc_near_list *wc_feature_state_near_list(wc_feature_state *state, int32_t collider);
+
+/// Path lengths of the particles' ends of step (near_list.h, clearances).
+/// At the start of a step's collision passes: each particle's path goes on
+/// to its start of step, which is noted, and then to its end.
+void wc_feature_state_begin_step(wc_feature_state *state, const wc_cloth *cloth);
+/// After particle i's end of step moved: its path goes on to it. Touches
+/// only particle i's entries (safe in a parallel loop over particles).
+void wc_feature_state_track(wc_feature_state *state, const wc_cloth *cloth, int32_t particle);
+/// Particle i's path length now.
+double wc_feature_state_path(const wc_feature_state *state, int32_t particle);
+/// How far particle i's start and end of step can be from where its end
+/// was when its path length was path_at (in this step or an earlier one).
+double wc_feature_state_drift(const wc_feature_state *state, int32_t particle, double path_at);
 
 /// The marks the particle pass and this pass leave each other between
 /// rounds (collide.h), kept here for the cloth.

@@ -48,12 +48,13 @@ static int made_for(const wc_near_list *l, const wc_collider *col)
 }
 
 int wc_near_list_holds(const wc_near_list *l, const wc_cloth *c, const wc_collider *col,
-                       double r_triangles, double r_edges, double r_particles)
+                       double r_triangles, double r_edges, double r_particles, const uint8_t *only)
 {
     if (!made_for(l, col) || l->r_triangles != r_triangles || l->r_edges != r_edges ||
         l->r_particles != r_particles || l->particle_count != c->particle_count)
         return 0;
     for (int32_t i = 0; i < c->particle_count; ++i) {
+        if (only && !only[i]) continue;
         const double *box = l->particle_boxes + 6 * (size_t)i;
         if (!inside(box, c->x[i], c->y[i], c->z[i]) || !inside(box, c->nx[i], c->ny[i], c->nz[i]))
             return 0;
@@ -198,6 +199,7 @@ wc_status wc_near_list_build(wc_near_list *l, const wc_cloth *c, const int32_t *
     /* particle i is element i: the slot array is its own identity map */
     for (int32_t i = 0; i < n && !s; ++i) l->particle_slot[i] = i;
     if (!s) s = list_elements(l, &l->particles, l->particle_slot, 1, n, &col->grid, col->bounds, r_particles);
+    if (!s) s = unknown_clearances(&l->particles, 1);
     if (s) return s;
     for (int32_t i = 0; i < n; ++i) l->particle_slot[i] = -1;
     for (int32_t k = 0; k < l->particles.count; ++k) l->particle_slot[l->particles.element[k]] = k;

@@ -79,9 +79,12 @@ void wc_near_list_init(wc_near_list *list);
 void wc_near_list_free(wc_near_list *list);
 
 /// Whether the lists still hold for this step's motion (x -> nx) of the
-/// cloth against this collider with these contact distances.
+/// cloth against this collider with these contact distances. With `only`,
+/// only the particles it marks are checked (the others have not moved
+/// since the lists were last found to hold).
 int wc_near_list_holds(const wc_near_list *list, const wc_cloth *cloth, const wc_collider *collider,
-                       double r_triangles, double r_edges, double r_particles);
+                       double r_triangles, double r_edges, double r_particles,
+                       const uint8_t *only);
 
 /// For one particle of the particle pass: whether the list was made for
 /// this collider (unchanged) with this r_particles and the particle is

@@ -144,6 +144,9 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory for the collision buffers of cloth %d; the world "
                            "keeps its last good state", (int)c);
+        /* the paths the passes' clearances are measured against
+         * (near_list.h) start from this step's motion */
+        if (w->collider_count) wc_feature_state_begin_step(cl->features, cl);
         /* Particles against collider faces, then collider vertices and edges
          * against the cloth's triangles and edges; the second can push a
          * particle back toward a face, so the two alternate until the
