@@ -51,6 +51,13 @@ struct wc_feature_state {
     double *motion2;
     /// Per particle: its path length at its start of step.
     double *path_start;
+    /// Per particle, the cloth triangles and the edges it belongs to (CSR),
+    /// so that a pass after the first finds the elements of the particles
+    /// the last one moved without looking at every element; and scratch
+    /// for that: a mark and a list per element slot.
+    int32_t *triangles_start, *triangles_of, *edges_start, *edges_of;
+    uint8_t *visit_mark;
+    int32_t *visit_list;
     /// Candidate collider features of one cloth element.
     int32_t *found;
     int32_t found_capacity;
@@ -115,6 +122,39 @@ static int compare_edge(const void *pa, const void *pb)
     return 0;
 }
 
+/* Inverts a list of elements (`per` particles each) into, per particle,
+ * the elements it belongs to, ascending; 0 on out-of-memory. */
+static int invert_elements(const int32_t *particles, int per, int32_t count, int32_t particle_count,
+                           int32_t **start_out, int32_t **items_out)
+{
+    int32_t *start = wc_alloc_array((size_t)particle_count + 1, sizeof *start);
+    int32_t *items = wc_alloc_array((size_t)per * (size_t)count, sizeof *items);
+    *start_out = start, *items_out = items;
+    if (!start || !items) return 0;
+    for (size_t k = 0; k < (size_t)per * (size_t)count; ++k) start[particles[k] + 1]++;
+    for (int32_t i = 0; i < particle_count; ++i) start[i + 1] += start[i];
+    for (int32_t e = 0; e < count; ++e)
+        for (int p = 0; p < per; ++p) {
+            int32_t i = particles[(size_t)per * (size_t)e + (size_t)p];
+            /* start[i] advances as i's slots fill; undone below */
+            items[start[i]++] = e;
+        }
+    for (int32_t i = particle_count; i > 0; --i) start[i] = start[i - 1];
+    start[0] = 0;
+    return 1;
+}
+
+static int particle_elements(const wc_cloth *c, wc_feature_state *s)
+{
+    int32_t n = c->particle_count, most = s->triangle_count > s->edge_count ? s->triangle_count : s->edge_count;
+    s->visit_mark = wc_alloc_array((size_t)most, sizeof *s->visit_mark);
+    s->visit_list = wc_alloc_array((size_t)most, sizeof *s->visit_list);
+    return s->visit_mark && s->visit_list &&
+           invert_elements(c->topology.triangles, 3, s->triangle_count, n, &s->triangles_start,
+                           &s->triangles_of) &&
+           invert_elements(s->edges, 2, s->edge_count, n, &s->edges_start, &s->edges_of);
+}
+
 wc_feature_state *wc_feature_state_create(const wc_cloth *c)
 {
     wc_feature_state *s = wc_alloc_array(1, sizeof *s);
@@ -162,6 +202,10 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
         s->triangle_edges[e[2]] = s->edge_count - 1;
     }
     wc_free(entries);
+    if (!particle_elements(c, s)) {
+        wc_feature_state_destroy(s);
+        return NULL;
+    }
     return s;
 }
 
@@ -189,6 +233,12 @@ void wc_feature_state_destroy(wc_feature_state *s)
     wc_free(s->path_end);
     wc_free(s->motion2);
     wc_free(s->path_start);
+    wc_free(s->triangles_start);
+    wc_free(s->triangles_of);
+    wc_free(s->edges_start);
+    wc_free(s->edges_of);
+    wc_free(s->visit_mark);
+    wc_free(s->visit_list);
     wc_free(s->found);
     for (int32_t k = 0; k < s->near_count; ++k) wc_near_list_free(&s->near[k]);
     wc_free(s->near);
@@ -585,17 +635,12 @@ typedef struct element_visit {
     int has_end;
 } element_visit;
 
-/* Whether the element must be visited at all: in a later pass only if a
- * particle of it moved, and with a near list only if it has drifted as
- * far as its least clearance or moves enough for continuous detection. */
+/* Whether the element must be visited at all: with a near list only if it
+ * has drifted as far as its least clearance or moves enough for
+ * continuous detection. */
 static int must_visit(const wc_feature_state *s, const wc_near_elements *near, int32_t k,
                       double limit2, element_visit *v)
 {
-    if (s->only_moved) {
-        int any = 0;
-        for (int p = 0; p < v->count; ++p) any |= s->moved[v->idx[p]];
-        if (!any) return 0;
-    }
     v->motion2 = element_motion2(s, v->idx, v->count);
     v->has_end = 0;
     v->drift = 0.0;
@@ -671,46 +716,88 @@ static int test_pair(wc_cloth *c, wc_feature_state *s, const wc_collider *col,
     return edge_edge(c, s, element, p0, p1, q0, q1, ccd, r, mu, dt, d2);
 }
 
-/* One kind of cloth element against the collider's features: each element
- * near the collider asks the feature grid (or the near list) for the
- * features near it and tests those it may touch. Returns 1 if anything
+/* Element k (its slot in the near list, else its id) against the collider
+ * features near it, testing those it may touch. Returns 1 if anything
  * moved, 0 if not, -1 on out-of-memory. */
+static int visit_element(wc_cloth *c, wc_feature_state *s, const wc_collider *col,
+                         wc_near_elements *near, const element_kind *kind, int32_t k, double r,
+                         double mu, double dt)
+{
+    int32_t element = near ? near->element[k] : k;
+    const int32_t *particles = kind->count == 3 ? c->topology.triangles : s->edges;
+    element_visit v;
+    v.idx = particles + (size_t)kind->count * (size_t)element, v.count = kind->count;
+    if (!must_visit(s, near, k, kind->ccd_limit2, &v)) return 0;
+    /* triangles grow by the largest contact distance, as their near lists
+     * were made; edges by this collider's */
+    element_box(c, v.idx, v.count, kind->count == 3 ? s->r_max : r, v.box);
+    if (!wc_boxes_overlap(v.box, col->bounds)) return 0;
+    const int32_t *found;
+    int32_t n = features_near(s, near, k, kind->grid, v.box, &found);
+    if (n < 0) return -1;
+    int pushed = 0;
+    double least = INFINITY;
+    for (int32_t j = 0; j < n; ++j) {
+        const int32_t *f = feature_vertices(col, kind, found + j);
+        int ccd = pair_needs_ccd(col, v.motion2, f, kind->feature_count, kind->ccd_limit2);
+        double clear = untested_clearance(c, near, k, j, &v,
+                                          kind->feature_boxes + 6 * (size_t)found[j], ccd, r);
+        if (clear < 0.0) {
+            double d2;
+            pushed |= test_pair(c, s, col, kind, element, f, ccd, r, mu, dt, &d2);
+            clear = sqrt(d2) - r;
+        }
+        if (near) near->clearance[near->start[k] + j] = clear;
+        least = min2(least, clear);
+    }
+    if (near) settle_clearances(s, near, k, v.idx, v.count, pushed, least);
+    return pushed;
+}
+
+/* Into s->visit_list, ascending, the elements (slots in the near list, else
+ * ids) with a particle the last pass moved; returns how many. They are
+ * marked first and then read off in order between the least and the
+ * greatest marked, which spares a sort. */
+static int32_t moved_elements(const wc_cloth *c, wc_feature_state *s, const wc_near_elements *near,
+                              const element_kind *kind)
+{
+    const int32_t *start = kind->count == 3 ? s->triangles_start : s->edges_start;
+    const int32_t *items = kind->count == 3 ? s->triangles_of : s->edges_of;
+    int32_t lo = INT32_MAX, hi = -1;
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        if (!s->moved[i]) continue;
+        for (int32_t j = start[i]; j < start[i + 1]; ++j) {
+            int32_t k = near ? near->slot_of[items[j]] : items[j];
+            if (k < 0) continue;
+            s->visit_mark[k] = 1;
+            if (k < lo) lo = k;
+            if (k > hi) hi = k;
+        }
+    }
+    int32_t n = 0;
+    for (int32_t k = lo; k <= hi; ++k)
+        if (s->visit_mark[k]) s->visit_mark[k] = 0, s->visit_list[n++] = k;
+    return n;
+}
+
+/* One kind of cloth element against the collider's features: in the first
+ * pass every element near the collider, in a later one only those with a
+ * particle the last pass moved (nothing else can have changed), in the
+ * same ascending order. Returns 1 if anything moved, 0 if not, -1 on
+ * out-of-memory. */
 static int element_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col,
                         wc_near_elements *near, const element_kind *kind, double r, double mu,
                         double dt)
 {
     int moved = 0;
-    int32_t count = near ? near->count : kind->count == 3 ? s->triangle_count : s->edge_count;
-    const int32_t *particles = kind->count == 3 ? c->topology.triangles : s->edges;
-    for (int32_t k = 0; k < count; ++k) {
-        int32_t element = near ? near->element[k] : k;
-        element_visit v;
-        v.idx = particles + (size_t)kind->count * (size_t)element, v.count = kind->count;
-        if (!must_visit(s, near, k, kind->ccd_limit2, &v)) continue;
-        /* triangles grow by the largest contact distance, as their near
-         * lists were made; edges by this collider's */
-        element_box(c, v.idx, v.count, kind->count == 3 ? s->r_max : r, v.box);
-        if (!wc_boxes_overlap(v.box, col->bounds)) continue;
-        const int32_t *found;
-        int32_t n = features_near(s, near, k, kind->grid, v.box, &found);
-        if (n < 0) return -1;
-        int pushed = 0;
-        double least = INFINITY;
-        for (int32_t j = 0; j < n; ++j) {
-            const int32_t *f = feature_vertices(col, kind, found + j);
-            int ccd = pair_needs_ccd(col, v.motion2, f, kind->feature_count, kind->ccd_limit2);
-            double clear = untested_clearance(c, near, k, j, &v,
-                                              kind->feature_boxes + 6 * (size_t)found[j], ccd, r);
-            if (clear < 0.0) {
-                double d2;
-                pushed |= test_pair(c, s, col, kind, element, f, ccd, r, mu, dt, &d2);
-                clear = sqrt(d2) - r;
-            }
-            if (near) near->clearance[near->start[k] + j] = clear;
-            least = min2(least, clear);
-        }
-        if (near) settle_clearances(s, near, k, v.idx, v.count, pushed, least);
-        moved |= pushed;
+    int32_t count = s->only_moved ? moved_elements(c, s, near, kind)
+                    : near        ? near->count
+                    : kind->count == 3 ? s->triangle_count : s->edge_count;
+    for (int32_t m = 0; m < count; ++m) {
+        int32_t k = s->only_moved ? s->visit_list[m] : m;
+        int result = visit_element(c, s, col, near, kind, k, r, mu, dt);
+        if (result < 0) return -1;
+        moved |= result;
     }
     return moved;
 }

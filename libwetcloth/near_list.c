@@ -20,6 +20,7 @@ static void elements_free(wc_near_elements *e)
     wc_free(e->element);
     wc_free(e->start);
     wc_free(e->found);
+    wc_free(e->slot_of);
     wc_free(e->path_at);
     wc_free(e->clearance);
     wc_free(e->least_clearance);
@@ -143,8 +144,11 @@ static wc_status list_elements(wc_near_list *l, wc_near_elements *out, const int
                                const double bounds[6], double r)
 {
     out->count = 0;
-    if (!reserve(&out->start, &out->start_capacity, 1)) return WC_ERROR_OUT_OF_MEMORY;
+    if (!reserve(&out->start, &out->start_capacity, 1) ||
+        !reserve(&out->slot_of, &out->slot_capacity, count))
+        return WC_ERROR_OUT_OF_MEMORY;
     out->start[0] = 0;
+    for (int32_t e = 0; e < count; ++e) out->slot_of[e] = -1;
     int64_t used = 0;
     for (int32_t e = 0; e < count; ++e) {
         double box[6];
@@ -162,6 +166,7 @@ static wc_status list_elements(wc_near_list *l, wc_near_elements *out, const int
             !reserve(&out->start, &out->start_capacity, out->count + 2))
             return WC_ERROR_OUT_OF_MEMORY;
         used += n;
+        out->slot_of[e] = out->count;
         out->element[out->count] = e;
         out->start[++out->count] = (int32_t)used;
     }

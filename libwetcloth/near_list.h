@@ -37,6 +37,9 @@ typedef struct wc_near_elements {
     int32_t *element;
     int32_t *start;
     int32_t *found;
+    /// Per element of the cloth (listed or not): its index k here, or -1.
+    int32_t *slot_of;
+    int64_t slot_capacity;
     int64_t element_capacity;
     int64_t start_capacity;
     int64_t found_capacity;
