@@ -72,6 +72,14 @@ double wc_buckling_energy(double d, double l, double R);
 /// full onset force. The ramp's slope enters the stable step bound.
 #define WC_BUCKLING_ONSET_RAMP 1e-3
 
+/// Phi of the gap with the onset ramp (see WC_BUCKLING_ONSET_RAMP): the
+/// force of wc_buckling_force_ramped is R / l^2 times this.
+static inline double wc_buckling_phi_ramped(double gap)
+{
+    if (gap >= WC_BUCKLING_ONSET_RAMP) return wc_buckling_phi_of_gap(gap);
+    return wc_buckling_phi_of_gap(WC_BUCKLING_ONSET_RAMP) * (gap / WC_BUCKLING_ONSET_RAMP);
+}
+
 /// Force magnitude, N, as the simulation applies it: wc_buckling_force with
 /// the onset ramp (see WC_BUCKLING_ONSET_RAMP). Inline: the force loop
 /// calls it for every compressed bend link of every step.

@@ -42,11 +42,15 @@ static void stretch_link_forces(wc_cloth *c, int threads)
         int32_t a = s->a[e], b = s->b[e];
         double dx = x[a] - x[b], dy = y[a] - y[b], dz = z[a] - z[b];
         double d2 = dx * dx + dy * dy + dz * dz;
-        double d = sqrt(d2);
-        double scale = d > s->rest[e] ? -k[e] * (d - s->rest[e]) / d : 0.0;
-        if (damp && d2 > 0.0) {
-            double dvx = c->vx[a] - c->vx[b], dvy = c->vy[a] - c->vy[b], dvz = c->vz[a] - c->vz[b];
-            scale -= damp[e] * (dvx * dx + dvy * dy + dvz * dz) / d2;
+        double d = sqrt(d2), scale = 0.0;
+        if (d2 > 0.0) {
+            /* one division per link: both terms divide by the length */
+            double inv_d = 1.0 / d;
+            if (d > s->rest[e]) scale = -k[e] * (d - s->rest[e]) * inv_d;
+            if (damp) {
+                double dvx = c->vx[a] - c->vx[b], dvy = c->vy[a] - c->vy[b], dvz = c->vz[a] - c->vz[b];
+                scale -= damp[e] * (dvx * dx + dvy * dy + dvz * dz) * (inv_d * inv_d);
+            }
         }
         c->link_fx[e] = scale * dx;
         c->link_fy[e] = scale * dy;
@@ -70,7 +74,12 @@ static void bend_link_forces(wc_cloth *c, int threads)
         double d = sqrt(dx * dx + dy * dy + dz * dz);
         double l = s->rest[e];
         double scale = 0.0;
-        if (d < l && d > FOLDED_FRACTION * l) scale = wc_buckling_force_ramped(d, l, r[e]) / d;
+        if (d < l && d > FOLDED_FRACTION * l) {
+            /* wc_buckling_force_ramped(d, l, R) / d with one division by l
+             * and one by d, not three divisions */
+            double inv_l = 1.0 / l;
+            scale = r[e] * inv_l * inv_l * wc_buckling_phi_ramped((l - d) * inv_l) / d;
+        }
         c->link_fx[offset + e] = scale * dx;
         c->link_fy[offset + e] = scale * dy;
         c->link_fz[offset + e] = scale * dz;
