@@ -95,8 +95,9 @@ trap 'rm -f "$tmp"' EXIT
   echo "## Threads: 1 and 2 threads, 1k to 262k particles"
   echo
   echo "The same resting cloth at every size; positions must end bitwise the same for every thread"
-  echo "count (the program fails otherwise). 16 threads, on the 16-core machine lent for it:"
-  echo "[bench/threads-16.md](bench/threads-16.md)."
+  echo "count (the program fails otherwise). On a 16-core machine: \`build/tools/bench_threads 30 1 2 4 8 16\`"
+  echo "(not yet run there: see [robustness.md](robustness.md#runs-and-their-counts) for what the"
+  echo "16-core machine lent to the project was used for)."
   echo
   echo '```'
   echo "build/tools/bench_threads 50 1 2"
