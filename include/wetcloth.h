@@ -199,7 +199,7 @@ typedef struct wc_material {
     /// Collision thickness of the cloth, m, [0, 1]: particles keep at least
     /// this much (plus the collider's thickness) from every surface, and at
     /// least this much from other parts of the same cloth when it
-    /// self-collides. Default 0.005.
+    /// self-collides, and from other cloths it collides with. Default 0.005.
     double thickness;
     /// Coulomb friction coefficient against colliders and itself, [0, 10].
     /// A contact uses sqrt(cloth friction * collider friction). Default 0.5.
@@ -268,6 +268,14 @@ typedef struct wc_mesh_cloth_def {
     /// 1 to keep the cloth from passing through itself, 0 (default) not to.
     /// Off costs nothing.
     int32_t self_collision;
+    /// 1 (default) to collide with the world's other cloths that have it
+    /// set, 0 not to: vertex-face and edge-edge contact with continuous
+    /// detection, friction sqrt(mu_a * mu_b), and the same guarantee of no
+    /// intersection as self-collision. Between cloths the thickness is the
+    /// larger of the two materials'. A world with fewer than two such
+    /// cloths pays nothing; cloths far apart pay one pass over their
+    /// particles per step. Wet cloths do not adhere to each other.
+    int32_t collide_with_cloths;
     /// Starting wetness of every particle, [0, 1]. Default 0 (dry).
     double wetness;
 } wc_mesh_cloth_def;
@@ -299,6 +307,14 @@ typedef struct wc_grid_cloth_def {
     wc_material material;
     /// 1 to keep the cloth from passing through itself, 0 (default) not to.
     int32_t self_collision;
+    /// 1 (default) to collide with the world's other cloths that have it
+    /// set, 0 not to: vertex-face and edge-edge contact with continuous
+    /// detection, friction sqrt(mu_a * mu_b), and the same guarantee of no
+    /// intersection as self-collision. Between cloths the thickness is the
+    /// larger of the two materials'. A world with fewer than two such
+    /// cloths pays nothing; cloths far apart pay one pass over their
+    /// particles per step. Wet cloths do not adhere to each other.
+    int32_t collide_with_cloths;
     /// Starting wetness of every particle, [0, 1]. Default 0 (dry).
     double wetness;
 } wc_grid_cloth_def;

@@ -83,6 +83,9 @@ typedef struct wc_cloth {
     uint8_t *history_override;
     /// Self-collision buffers; NULL when self-collision is off.
     struct wc_self_state *self;
+    /// Whether the cloth collides with the world's other cloths that do
+    /// (cloth_group.h).
+    int collide_cloths;
     /// Buffers for collider vertices and edges against this cloth; made
     /// at the first step with a mesh collider.
     struct wc_feature_state *features;

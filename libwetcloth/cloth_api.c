@@ -19,6 +19,7 @@ wc_mesh_cloth_def wc_mesh_cloth_def_default(void)
     memset(&d, 0, sizeof d);
     d.face_size = 3;
     d.material = wc_material_default();
+    d.collide_with_cloths = 1;
     return d;
 }
 
@@ -31,6 +32,7 @@ wc_grid_cloth_def wc_grid_cloth_def_default(void)
     d.axis_u[0] = 1.0;
     d.axis_v[1] = 1.0;
     d.material = wc_material_default();
+    d.collide_with_cloths = 1;
     return d;
 }
 
@@ -79,6 +81,10 @@ wc_status wc_world_add_mesh_cloth(wc_world *w, const wc_mesh_cloth_def *d, int32
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.self_collision must be 0 or 1 but is %d",
                        (int)d->self_collision);
+    if (d->collide_with_cloths != 0 && d->collide_with_cloths != 1)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "mesh_cloth_def.collide_with_cloths must be 0 or 1 but is %d",
+                       (int)d->collide_with_cloths);
     if (!(d->wetness >= 0.0 && d->wetness <= 1.0))
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.wetness must be in [0, 1] but is %g", d->wetness);
@@ -88,6 +94,7 @@ wc_status wc_world_add_mesh_cloth(wc_world *w, const wc_mesh_cloth_def *d, int32
     s = wc_cloth_create(&c, d->vertices, d->vertex_count, d->faces, d->face_count, d->face_size,
                         &d->material, d->self_collision, d->wetness, msg);
     if (s) return s;
+    c->collide_cloths = d->collide_with_cloths;
     return append_cloth(w, c, out_cloth);
 }
 
@@ -124,6 +131,10 @@ static wc_status validate_grid(const wc_grid_cloth_def *d, wc_message *msg)
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.self_collision must be 0 or 1 but is %d",
                        (int)d->self_collision);
+    if (d->collide_with_cloths != 0 && d->collide_with_cloths != 1)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "grid_cloth_def.collide_with_cloths must be 0 or 1 but is %d",
+                       (int)d->collide_with_cloths);
     if (!(d->wetness >= 0.0 && d->wetness <= 1.0))
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.wetness must be in [0, 1] but is %g", d->wetness);
@@ -168,6 +179,7 @@ wc_status wc_world_add_grid_cloth(wc_world *w, const wc_grid_cloth_def *d, int32
     wc_free(xyz);
     wc_free(faces);
     if (s) return s;
+    c->collide_cloths = d->collide_with_cloths;
     return append_cloth(w, c, out_cloth);
 }
 

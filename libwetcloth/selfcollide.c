@@ -194,6 +194,16 @@ struct wc_self_state {
     /// moved since), so a broadphase right after need not make them again.
     int cones_current;
     double built_h;
+
+    /* Pieces (NULL for one cloth): see wc_self_pieces. */
+    int32_t piece_count;
+    /// Piece of each particle and of each patch (patches never span pieces:
+    /// they are connected across shared edges).
+    int32_t *particle_piece, *patch_piece;
+    /// Per piece: whether pairs within it are tested; friction and wet
+    /// friction of its material.
+    uint8_t *piece_self;
+    double *piece_friction, *piece_wet_friction;
 };
 
 /* ------------------------------------------------------------------------ */
@@ -531,7 +541,44 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
     return ok;
 }
 
-wc_self_state *wc_self_state_create(const wc_cloth *c)
+/* Copies the pieces into the state: each particle's and each patch's piece
+ * and the per-piece settings. */
+static int set_pieces(wc_self_state *s, const wc_self_pieces *pieces)
+{
+    int32_t m = pieces->count;
+    s->piece_count = m;
+    s->particle_piece = wc_alloc_array((size_t)s->particle_count, sizeof *s->particle_piece);
+    s->patch_piece = wc_alloc_array((size_t)s->patch_count, sizeof *s->patch_piece);
+    s->piece_self = wc_alloc_array((size_t)m, 1);
+    s->piece_friction = wc_alloc_array((size_t)m, sizeof *s->piece_friction);
+    s->piece_wet_friction = wc_alloc_array((size_t)m, sizeof *s->piece_wet_friction);
+    if (!s->particle_piece || !s->patch_piece || !s->piece_self || !s->piece_friction ||
+        !s->piece_wet_friction)
+        return 0;
+    for (int32_t k = 0; k < m; ++k)
+        for (int32_t i = pieces->first[k]; i < pieces->first[k + 1]; ++i) s->particle_piece[i] = k;
+    for (int32_t p = 0; p < s->patch_count; ++p) {
+        int32_t t = s->patch_triangles.items[s->patch_triangles.start[p]];
+        s->patch_piece[p] = s->particle_piece[s->triangles[3 * (size_t)t]];
+    }
+    memcpy(s->piece_self, pieces->self, (size_t)m);
+    wc_self_state_set_friction(s, pieces->friction, pieces->wet_friction);
+    return 1;
+}
+
+void wc_self_state_set_friction(wc_self_state *s, const double *friction, const double *wet_friction)
+{
+    memcpy(s->piece_friction, friction, (size_t)s->piece_count * sizeof *friction);
+    memcpy(s->piece_wet_friction, wet_friction, (size_t)s->piece_count * sizeof *wet_friction);
+}
+
+void wc_self_state_invalidate(wc_self_state *s) { s->built = 0; }
+
+const double *wc_self_state_rest(const wc_self_state *s) { return s->rest; }
+
+wc_self_state *wc_self_state_create(const wc_cloth *c) { return wc_self_state_create_pieces(c, NULL); }
+
+wc_self_state *wc_self_state_create_pieces(const wc_cloth *c, const wc_self_pieces *pieces)
 {
     wc_self_state *s = wc_alloc_array(1, sizeof *s);
     if (!s) return NULL;
@@ -590,6 +637,10 @@ wc_self_state *wc_self_state_create(const wc_cloth *c)
         double *box = s->rest_edge_boxes + 6 * e;
         for (int k = 0; k < 3; ++k) box[k] = min2(a[k], b[k]), box[k + 3] = max2(a[k], b[k]);
     }
+    if (pieces && !set_pieces(s, pieces)) {
+        wc_self_state_destroy(s);
+        return NULL;
+    }
     return s;
 }
 
@@ -601,7 +652,9 @@ void wc_self_state_destroy(wc_self_state *s)
                       s->particle_boxes, s->triangle_boxes, s->edge_boxes, s->triangle_normals,
                       s->patch_boxes, s->patch_grown, s->patch_axis, s->patch_cos, s->patch_fit,
                       s->patch_culled, s->adjacent_culled, s->patch_touched, s->open, s->joined, s->vf,
-                      s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted, s->vf_h};
+                      s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted, s->vf_h,
+                      s->particle_piece, s->patch_piece, s->piece_self, s->piece_friction,
+                      s->piece_wet_friction};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
     csr_free(&s->patch_triangles);
     csr_free(&s->patch_particles);
@@ -752,6 +805,10 @@ static void patch_pairs_slice(wc_self_state *s, pair_slice *sl, int32_t first, i
         for (int32_t k = 0; k < found; ++k) {
             int32_t q = sl->query[k], how;
             if (q < p) continue;
+            /* a piece without self-collision only meets other pieces */
+            if (s->patch_piece && s->patch_piece[p] == s->patch_piece[q] &&
+                !s->piece_self[s->patch_piece[p]])
+                continue;
             if (q == p) {
                 if (s->patch_cos[p] > CONE_COS) continue;
                 how = -1;
@@ -823,6 +880,8 @@ static int32_t *slice_scratch(pair_slice *sl, int32_t count)
 typedef struct self_ctx {
     const double *x, *y, *z, *nx, *ny, *nz;
     const double *rest;
+    /// Piece of each particle, or NULL for one cloth.
+    const int32_t *piece;
     /// Thickness, CCD tolerance, squared rest distance below which a pair
     /// counts as neighbours (see pair_thickness).
     double h, tol, exclude2;
@@ -845,8 +904,17 @@ static double pair_thickness(const self_ctx *ctx, double rest2)
     return t;
 }
 
+/* Different pieces are different cloths: how far apart they were at rest
+ * means nothing, so their pairs keep the full thickness. For both kinds of
+ * pair ids[0] is on the first element and ids[3] on the second. */
+static int across_pieces(const self_ctx *ctx, const int32_t ids[4])
+{
+    return ctx->piece && ctx->piece[ids[0]] != ctx->piece[ids[3]];
+}
+
 static double rest2_vf(const self_ctx *ctx, const int32_t ids[4])
 {
+    if (across_pieces(ctx, ids)) return INFINITY;
     double bary[3];
     const double *r = ctx->rest;
     return wc_point_triangle_closest(r + 3 * (size_t)ids[0], r + 3 * (size_t)ids[1],
@@ -855,6 +923,7 @@ static double rest2_vf(const self_ctx *ctx, const int32_t ids[4])
 
 static double rest2_ee(const self_ctx *ctx, const int32_t ids[4])
 {
+    if (across_pieces(ctx, ids)) return INFINITY;
     double u, v;
     const double *r = ctx->rest;
     return wc_segment_segment_closest(r + 3 * (size_t)ids[0], r + 3 * (size_t)ids[1],
@@ -1334,9 +1403,26 @@ static double sustained_wetness(const wc_cloth *c, const self_contact *k)
     return wet;
 }
 
-static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double mu, double slack,
-                   int32_t *marked)
+/* Coulomb and wet friction of a pair (mu, q): the cloth's; between two
+ * pieces the geometric mean of theirs, as a cloth meets a collider. */
+static void pair_friction(const wc_cloth *c, const wc_self_state *s, const self_contact *k,
+                          double out[2])
 {
+    out[0] = c->material.friction, out[1] = c->material.wet_friction;
+    if (!s->particle_piece) return;
+    int32_t a = s->particle_piece[k->p[0]], b = s->particle_piece[k->p[3]];
+    if (a == b) {
+        out[0] = s->piece_friction[a], out[1] = s->piece_wet_friction[a];
+    } else {
+        out[0] = sqrt(s->piece_friction[a] * s->piece_friction[b]);
+        out[1] = sqrt(s->piece_wet_friction[a] * s->piece_wet_friction[b]);
+    }
+}
+
+static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, const double friction[2],
+                   double slack, int32_t *marked)
+{
+    double mu = friction[0];
     double im[4], weight = 0.0;
     if (dot3(k->n, k->n) == 0.0) return 0;
     for (int j = 0; j < 4; ++j) {
@@ -1402,7 +1488,7 @@ static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double 
         if (len > 0.0) {
             double f = mu * dv / len;
             if (f > 1.0) f = 1.0;
-            if (wet > 0.0) f = 1.0 - (1.0 - f) * (1.0 - wet * (1.0 - c->material.wet_friction));
+            if (wet > 0.0) f = 1.0 - (1.0 - f) * (1.0 - wet * (1.0 - friction[1]));
             for (int m = 0; m < 3; ++m) ft[m] = -f * vt[m];
         }
     }
@@ -1435,19 +1521,23 @@ static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, double 
 static int respond_all(wc_cloth *c, wc_self_state *s, const self_ctx *ctx, int pass,
                        int32_t *marked)
 {
-    double mu = c->material.friction, slack = pass ? RESIDUAL * ctx->h : 0.0;
+    double friction[2], slack = pass ? RESIDUAL * ctx->h : 0.0;
     int moved = 0;
     for (int64_t i = 0; i < s->vf_count; ++i) {
         if (!s->vf_status[i]) continue;
         self_contact k;
         s->vf_status[i] = (uint8_t)vf_pair(s, ctx, i, 0, &k);
-        if (s->vf_status[i]) moved |= respond(c, s, &k, mu, slack, marked);
+        if (!s->vf_status[i]) continue;
+        pair_friction(c, s, &k, friction);
+        moved |= respond(c, s, &k, friction, slack, marked);
     }
     for (int64_t i = 0; i < s->ee_count; ++i) {
         if (!s->ee_status[i]) continue;
         self_contact k;
         s->ee_status[i] = (uint8_t)ee_pair(s, ctx, i, 0, &k);
-        if (s->ee_status[i]) moved |= respond(c, s, &k, mu, slack, marked);
+        if (!s->ee_status[i]) continue;
+        pair_friction(c, s, &k, friction);
+        moved |= respond(c, s, &k, friction, slack, marked);
     }
     return moved;
 }
@@ -1599,6 +1689,7 @@ wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *st
     ctx.tol = CCD_TOLERANCE * ctx.h;
     ctx.exclude2 = (REST_EXCLUSION * ctx.h) * (REST_EXCLUSION * ctx.h);
     ctx.rest = s->rest;
+    ctx.piece = s->particle_piece;
     /* nx/ny/nz are the cloth's current arrays (they swap at commit). */
     ctx.x = c->x, ctx.y = c->y, ctx.z = c->z, ctx.nx = c->nx, ctx.ny = c->ny, ctx.nz = c->nz;
     double g = BOX_MARGIN * ctx.h;

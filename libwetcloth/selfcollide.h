@@ -16,6 +16,34 @@ typedef struct wc_self_state wc_self_state;
 wc_self_state *wc_self_state_create(const wc_cloth *cloth);
 void wc_self_state_destroy(wc_self_state *state);
 
+/// Several cloths as pieces of one combined cloth (cloth_group.h): piece k
+/// holds particles [first[k], first[k + 1]). Pairs of two pieces are always
+/// tested and keep the full thickness (their distance at rest means
+/// nothing); pairs within piece k only when self[k]. A pair's friction is
+/// its piece's, or between pieces the geometric mean of theirs.
+typedef struct wc_self_pieces {
+    int32_t count;
+    const int32_t *first;
+    const uint8_t *self;
+    const double *friction, *wet_friction;
+} wc_self_pieces;
+
+/// The state for a combined cloth of pieces (copied); the combined cloth's
+/// positions are the rest shape. NULL on out-of-memory.
+wc_self_state *wc_self_state_create_pieces(const wc_cloth *combined, const wc_self_pieces *pieces);
+
+/// New friction and wet friction per piece (materials can change).
+void wc_self_state_set_friction(wc_self_state *state, const double *friction,
+                                const double *wet_friction);
+
+/// Drops the candidate pairs: the next call rebuilds them. For a state that
+/// skipped steps, in which its particles moved out of the boxes the
+/// candidates were made for.
+void wc_self_state_invalidate(wc_self_state *state);
+
+/// The rest shape the state was made with, xyz per particle.
+const double *wc_self_state_rest(const wc_self_state *state);
+
 /// Resolves self-collisions of the motion from (x, y, z) to (nx, ny, nz):
 /// moves nx/ny/nz, sets the history override (qx/qy/qz, history_override)
 /// where it changes velocities through the previous position, and marks

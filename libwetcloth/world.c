@@ -5,6 +5,7 @@
 
 #include "alloc.h"
 #include "clock.h"
+#include "cloth_group.h"
 #include "collide.h"
 #include "collide_features.h"
 #include "forces.h"
@@ -88,6 +89,7 @@ void wc_world_destroy(wc_world *w)
     wc_free(w->cloths);
     wc_free(w->colliders);
     wc_contact_backup_free(&w->backup);
+    wc_cloth_group_destroy(w->group);
     wc_free(w);
 }
 
@@ -107,11 +109,11 @@ wc_cloth *wc_world_find_cloth(const wc_world *w, int32_t cloth, const char *call
 /* Stepping                                                                  */
 /* ------------------------------------------------------------------------ */
 
-static int any_self_collision(const wc_world *w)
+static int any_cloth_collision(const wc_world *w)
 {
     for (int32_t c = 0; c < w->cloth_count; ++c)
         if (w->cloths[c]->self) return 1;
-    return 0;
+    return wc_cloth_group_possible(w->cloths, w->cloth_count);
 }
 
 static wc_status non_finite_error(wc_world *w, double dt, int32_t cloth, int32_t particle,
@@ -167,11 +169,21 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
          * on their collider */
         if (cl->wet_forces && w->collider_count)
             wc_wet_hold_contacts(cl, w->colliders, w->collider_count, threads);
-        if (cl->self && wc_self_collide(cl, dt, threads, &w->stats))
+    }
+    /* cloths against each other, after all their collider passes */
+    if (wc_cloth_group_sync(&w->group, w->cloths, w->cloth_count) ||
+        (w->group && wc_cloth_group_collide(w->group, w->cloths, dt, threads, &w->stats)))
+        return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                       "out of memory in the collision between cloths; the world keeps its last "
+                       "good state");
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
+        wc_cloth *cl = w->cloths[c];
+        int alone = !wc_cloth_group_handled(w->group, c);
+        if (alone && cl->self && wc_self_collide(cl, dt, threads, &w->stats))
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory in the self-collision of cloth %d; the world keeps its "
                            "last good state", (int)c);
-        if (cl->self && cl->wet_forces && wc_wet_self_pairs(cl, wc_self_thickness(cl)))
+        if (alone && cl->self && cl->wet_forces && wc_wet_self_pairs(cl, wc_self_thickness(cl)))
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory for the self-adhesion of cloth %d; the world keeps its "
                            "last good state", (int)c);
@@ -235,7 +247,7 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
         if (s) return s;
     }
     t1 = wc_clock_seconds(), phase[1] += t1 - t0, t0 = t1;
-    int colliding = w->collider_count > 0 || any_self_collision(w);
+    int colliding = w->collider_count > 0 || any_cloth_collision(w);
     if (colliding) {
         /* collision changes contacts before it knows it will succeed: a
          * failed step puts them back (contact_backup.h) */

@@ -27,6 +27,9 @@ struct wc_world {
     wc_message error;
     /// Contact state saved before each step's collision (contact_backup.h).
     wc_contact_backup backup;
+    /// The cloths that collide with each other (cloth_group.h); NULL while
+    /// fewer than two do.
+    struct wc_cloth_group *group;
 };
 
 /// The world's message buffer, writable from const entry points.

@@ -219,6 +219,19 @@ static void test_grid_def(void)
     g = wc_grid_cloth_def_default();
     g.center[2] = INFINITY;
     expect(wc_world_add_grid_cloth(wa, &g, &id), WC_ERROR_INVALID_ARGUMENT, "grid center inf", "center", NULL);
+    g = wc_grid_cloth_def_default();
+    CHECK(g.collide_with_cloths == 1, "grid collide_with_cloths defaults to %d", (int)g.collide_with_cloths);
+    g.collide_with_cloths = 2;
+    expect(wc_world_add_grid_cloth(wa, &g, &id), WC_ERROR_INVALID_ARGUMENT, "grid collide_with_cloths = 2",
+           "grid_cloth_def.collide_with_cloths", "0 or 1");
+    wc_mesh_cloth_def m = wc_mesh_cloth_def_default();
+    CHECK(m.collide_with_cloths == 1, "mesh collide_with_cloths defaults to %d", (int)m.collide_with_cloths);
+    static const double tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    static const int32_t face[3] = {0, 1, 2};
+    m.vertices = tri, m.vertex_count = 3, m.faces = face, m.face_count = 1;
+    m.collide_with_cloths = -1;
+    expect(wc_world_add_mesh_cloth(wa, &m, &id), WC_ERROR_INVALID_ARGUMENT, "mesh collide_with_cloths = -1",
+           "mesh_cloth_def.collide_with_cloths", "-1");
     CHECK(id == -1, "out_cloth written on failure (%d)", id);
 }
 

@@ -271,6 +271,26 @@ def test_contact_and_stuck_on_a_sphere():
     w.close()
 
 
+@pytest.mark.parametrize("collide", [True, False])
+def test_two_cloths_collide_unless_told_not_to(collide):
+    # a cloth dropped onto another lying on a box rests on it when both
+    # collide with cloths (the default), and falls through it when not
+    with World() as w:
+        w.add_box((0.0, 0.0, -0.1), (1.0, 1.0, 0.1))
+        lower = w.add_grid_cloth(10, 10, size=(0.6, 0.6), center=(0.0, 0.0, 0.01))
+        upper = w.add_grid_cloth(10, 10, size=(0.5, 0.5), center=(0.0, 0.0, 0.08),
+                                 collide_with_cloths=collide)
+        worst = 0
+        for _ in range(12):
+            w.advance(1 / 24)
+            worst = max(worst, w.count_intersections()["cloth_cloth"])
+        gap = upper.positions[:, 2].mean() - lower.positions[:, 2].mean()
+        if collide:
+            assert worst == 0 and 0.004 < gap < 0.02, (worst, gap)
+        else:
+            assert worst > 0 and abs(gap) < 0.004, (worst, gap)
+
+
 # ---------------------------------------------------------------------------
 # colliders
 

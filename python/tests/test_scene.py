@@ -26,6 +26,7 @@ def test_defaults():
     assert c["name"] == "cloth" and c["wetness"] == 0.0 and c["pins"] == []
     assert c["grid"]["size"] == [1.0, 1.0] and c["grid"]["center"] == [0.0, 0.0, 0.0]
     assert c["material"] == {} and c["self_collision"] is False
+    assert c["collide_with_cloths"] is True
     assert s.colliders == []
 
 

@@ -265,11 +265,13 @@ class World:
 
     def add_grid_cloth(self, nu, nv, size=(1.0, 1.0), center=(0.0, 0.0, 0.0), material=None,
                        wetness=0.0, self_collision=False, axis_u=(1.0, 0.0, 0.0),
-                       axis_v=(0.0, 1.0, 0.0)):
+                       axis_v=(0.0, 1.0, 0.0), collide_with_cloths=True):
         """A regular grid of nu x nv particles, size (m) along axis_u and
         axis_v, centred at center (m). Particle (i, j) has index j*nu + i;
         x grows with i and y with j (with the default axes), in the plane
-        z = center[2]. wetness: a scalar or one value per particle, [0, 1]."""
+        z = center[2]. wetness: a scalar or one value per particle, [0, 1].
+        collide_with_cloths: collide with the world's other cloths that do
+        (wc_grid_cloth_def.collide_with_cloths)."""
         h = self._handle()
         d = lib.wc_grid_cloth_def_default()
         d.count_u = _int32("nu", nu)
@@ -281,6 +283,7 @@ class World:
         d.axis_v = list(_vector("axis_v", axis_v, 3))
         d.material = _c_material(material)
         d.self_collision = 1 if self_collision else 0
+        d.collide_with_cloths = 1 if collide_with_cloths else 0
         n = d.count_u * d.count_v if d.count_u > 0 and d.count_v > 0 else 0
         uniform, wet_map = self._wetness_arg(wetness, n)
         d.wetness = uniform
@@ -293,10 +296,13 @@ class World:
         faces = np.stack([base, base + 1, base + nu_ + 1, base + nu_], axis=1).astype(np.int32)
         return self._new_cloth(out[0], faces, wet_map)
 
-    def add_cloth(self, vertices, faces, material=None, wetness=0.0, self_collision=False):
+    def add_cloth(self, vertices, faces, material=None, wetness=0.0, self_collision=False,
+                  collide_with_cloths=True):
         """A cloth from a mesh: vertices (n, 3) in m, faces (F, 3) or (F, 4)
         vertex indices (with 4 columns, a last index of -1 makes a triangle).
-        wetness: a scalar or one value per vertex, [0, 1]."""
+        wetness: a scalar or one value per vertex, [0, 1]. collide_with_cloths:
+        collide with the world's other cloths that do
+        (wc_mesh_cloth_def.collide_with_cloths)."""
         h = self._handle()
         v = _float_array("vertices", vertices, 3)
         f = _index_array("faces", faces, (3, 4))
@@ -308,6 +314,7 @@ class World:
         d.face_size = f.shape[1]
         d.material = _c_material(material)
         d.self_collision = 1 if self_collision else 0
+        d.collide_with_cloths = 1 if collide_with_cloths else 0
         uniform, wet_map = self._wetness_arg(wetness, v.shape[0])
         d.wetness = uniform
         out = ffi.new("int32_t *")

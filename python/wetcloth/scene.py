@@ -178,7 +178,7 @@ MATERIAL_FIELDS = list(_core._MATERIAL_FIELDS)
 SCENE_FIELDS = ["description", "format_version", "duration", "fps", "substeps", "threads",
                 "gravity", "start_frame", "integrator", "cloths", "colliders"]
 CLOTH_FIELDS = ["name", "grid", "obj", "material", "wetness", "pins", "pin_keyframes",
-                "self_collision"]
+                "self_collision", "collide_with_cloths"]
 GRID_FIELDS = ["nu", "nv", "size", "center", "axis_u", "axis_v"]
 COLLIDER_TYPES = ["mesh", "sphere", "box", "capsule", "convex"]
 COLLIDER_FIELDS = {
@@ -344,6 +344,7 @@ def _cloth(scene, path, item, index):
     if c["pin_keyframes"].times.size and not pins:
         r.fail("pin_keyframes", "there are no pins to move")
     c["self_collision"] = r.boolean("self_collision", False)
+    c["collide_with_cloths"] = r.boolean("collide_with_cloths", True)
     return c
 
 
@@ -457,11 +458,13 @@ def build(scene, threads=None):
                 cloth = guarded(c["path"], world.add_grid_cloth, g["nu"], g["nv"],
                                 size=g["size"], center=g["center"], axis_u=g["axis_u"],
                                 axis_v=g["axis_v"], material=material, wetness=wetness,
-                                self_collision=c["self_collision"])
+                                self_collision=c["self_collision"],
+                                collide_with_cloths=c["collide_with_cloths"])
             else:
                 cloth = guarded(c["path"], world.add_cloth, c["vertices"], c["faces"],
                                 material=material, wetness=wetness,
-                                self_collision=c["self_collision"])
+                                self_collision=c["self_collision"],
+                                collide_with_cloths=c["collide_with_cloths"])
             start = np.zeros((0, 3))
             if c["pins"]:
                 guarded(c["path"] + ".pins", cloth.pin, c["pins"])

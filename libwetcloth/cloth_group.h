@@ -1,0 +1,48 @@
+/* Collision between the different cloths of one world. The cloths that
+ * collide with cloths (collide_with_cloths in their description) form the
+ * world's group; for collision they are pieces of one combined cloth, and
+ * the self-collision of that combined cloth (selfcollide.c) answers all of
+ * its pairs, within a cloth (where that cloth self-collides) and between
+ * cloths, in one set of passes with one fail-safe. The guarantee that a step
+ * ends free of intersections then covers them together, which separate
+ * passes could not give: answering cloth A against cloth B could push A
+ * through itself, and nothing would look again.
+ *
+ * A step in which no two members' motions come within the thickness of
+ * each other leaves every cloth to its own self-collision, so cloths far
+ * apart pay one pass over their particles. A world with fewer than two
+ * members has no group and pays nothing. */
+#ifndef WC_CLOTH_GROUP_H
+#define WC_CLOTH_GROUP_H
+
+#include "cloth.h"
+
+typedef struct wc_cloth_group wc_cloth_group;
+
+/// Makes, remakes or drops *group to match the world's cloths (members: the
+/// cloths with collide_cloths set, in world order; a group needs two).
+/// Cheap when nothing changed. Non-zero on out-of-memory, with *group as it
+/// was.
+int wc_cloth_group_sync(wc_cloth_group **group, wc_cloth *const *cloths, int32_t cloth_count);
+
+void wc_cloth_group_destroy(wc_cloth_group *group);
+
+/// After every cloth's collider passes: when two members' motions x -> nx
+/// come within the group's thickness, resolves the collisions of all
+/// members together (moves nx, sets history overrides and contacts as the
+/// self-collision does; records and updates the self-adhesion of wet
+/// self-colliding members), and marks them handled; otherwise marks none.
+/// Deterministic for any thread count. WC_ERROR_OUT_OF_MEMORY on
+/// out-of-memory (the caller restores the contact state).
+wc_status wc_cloth_group_collide(wc_cloth_group *group, wc_cloth *const *cloths, double dt,
+                                 int threads, wc_step_stats *stats);
+
+/// Whether the last wc_cloth_group_collide resolved cloth `cloth` (a world
+/// index): then its own self-collision must not run in that step.
+int wc_cloth_group_handled(const wc_cloth_group *group, int32_t cloth);
+
+/// Whether the cloths can collide with each other at all: two or more with
+/// collide_cloths set.
+int wc_cloth_group_possible(wc_cloth *const *cloths, int32_t cloth_count);
+
+#endif
