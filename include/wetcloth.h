@@ -54,8 +54,10 @@ typedef enum wc_status {
     WC_ERROR_INVALID_ARGUMENT = 1,
     /// An allocation failed; the world is as it was before the call.
     WC_ERROR_OUT_OF_MEMORY = 2,
-    /// The step would have produced a non-finite position (usually a time step
-    /// far above wc_world_stable_dt()). The world keeps its last good state.
+    /// The step would have produced a non-finite position, or (Verlet) it is
+    /// unstable: a time step above what the integrator keeps stable, seen by
+    /// the growing, alternating oscillation it starts. The world keeps its
+    /// last good state.
     WC_ERROR_NON_FINITE = 3,
     /// A cloth or collider index that the world does not have.
     WC_ERROR_NOT_FOUND = 4

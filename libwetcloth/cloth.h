@@ -5,6 +5,7 @@
 
 #include <stdint.h>
 
+#include "step_guard.h"
 #include "topology.h"
 #include "wetcloth.h"
 
@@ -70,6 +71,9 @@ typedef struct wc_cloth {
     /// their first step: NULL in a Verlet world, which pays nothing for them.
     struct wc_xpbd_state *xpbd;
     struct wc_implicit_state *implicit;
+    /// The unstable-step guard's history, and what it becomes if the step
+    /// being computed succeeds (step_guard.h).
+    wc_step_guard guard, guard_next;
 
     /* Collisions. */
     /// wc_contact_kind of each particle in the last step.

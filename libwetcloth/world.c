@@ -14,6 +14,7 @@
 #include "parallel.h"
 #include "selfcollide.h"
 #include "status.h"
+#include "step_guard.h"
 #include "wetness.h"
 #include "xpbd.h"
 
@@ -123,6 +124,29 @@ static wc_status non_finite_error(wc_world *w, double dt, int32_t cloth, int32_t
                    "step of %g s would move particle %d of cloth %d to a non-finite position "
                    "(in %s); the stable step is about %g s. The world keeps its last good state",
                    dt, (int)particle, (int)cloth, phase, w->cloths[cloth]->stable_dt);
+}
+
+/* A Verlet step that makes a cloth oscillate with growing amplitude
+ * (step_guard.h) fails before it is committed. The large-step integrators
+ * are stable by construction; their tension-only links can chatter in a way
+ * the guard would mistake for growth (measured: the implicit integrator on
+ * a 1e9 N/m cloth, whose energy did not grow). */
+static wc_status guard_steps(wc_world *w, double dt, int threads)
+{
+    if (w->def.integrator != WC_INTEGRATOR_VERLET) return WC_OK;
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
+        wc_cloth *cl = w->cloths[c];
+        int32_t p = wc_step_guard_check(cl, &cl->guard, dt, threads, &cl->guard_next);
+        if (p >= 0)
+            return wc_fail(&w->error, WC_ERROR_NON_FINITE,
+                           "step of %g s is unstable: particle %d of cloth %d oscillates with an "
+                           "amplitude that grew %.3g-fold over the last %d steps (the stable step "
+                           "is about %g s). The world keeps its last good state; take shorter "
+                           "steps (wc_world_advance with 0 substeps picks them)",
+                           dt, (int)p, (int)c, cl->guard_next.growth, (int)cl->guard_next.run,
+                           cl->stable_dt);
+    }
+    return WC_OK;
 }
 
 /* Colliders move to where they are at the end of this step; each contact
@@ -246,6 +270,8 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
         wc_status s = integrate_cloth(w, c, dt, pin_fraction, threads);
         if (s) return s;
     }
+    wc_status s = guard_steps(w, dt, threads);
+    if (s) return s;
     t1 = wc_clock_seconds(), phase[1] += t1 - t0, t0 = t1;
     int colliding = w->collider_count > 0 || any_cloth_collision(w);
     if (colliding) {
@@ -255,7 +281,7 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory saving the contact state; the world keeps its last "
                            "good state");
-        wc_status s = collide(w, dt, share, threads);
+        s = collide(w, dt, share, threads);
         if (s) {
             wc_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
             return s;
@@ -265,7 +291,10 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
     if (colliding)
         for (int32_t c = 0; c < w->cloth_count; ++c)
             w->stats.stuck_particles += wc_wet_mark_stuck(w->cloths[c]);
-    for (int32_t c = 0; c < w->cloth_count; ++c) wc_cloth_commit(w->cloths[c], dt, colliding);
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
+        wc_cloth_commit(w->cloths[c], dt, colliding);
+        w->cloths[c]->guard = w->cloths[c]->guard_next;
+    }
     for (int32_t k = 0; k < w->collider_count; ++k) wc_collider_end_step(w->colliders[k]);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         const wc_material *m = &w->cloths[c]->material;

@@ -242,13 +242,18 @@ static uint64_t case_auto_substeps(int32_t threads, int report)
 
 /* The same cloth with steps forced to k x the stable estimate (Verlet, 400
  * steps, capped at the API's 10 s). Checked: every position finite after
- * every call, and a failed step is WC_ERROR_NON_FINITE keeping the state
- * before it. Reported, not checked (a known gap): whether the cloth left
- * sanity (energy above its start by 2 % of m g L, or spanning more than 3 m
- * while hanging from pins 1 m apart) on a step that returned WC_OK. Today
- * Verlet at 2x and more runs on for tens of steps to ~1e150 m before a
- * position overflows and the step fails: the "last good state" it keeps is
- * an exploded cloth. */
+ * every call; a failed step is WC_ERROR_NON_FINITE keeping the state before
+ * it; at 1.5x (stable: the estimate is a bound) all 400 steps succeed, so
+ * the step guard (step_guard.h) does not fire on a stable run; from 3x on
+ * the run fails, and by the guard ("unstable"), not by a position
+ * overflowing; at 3x and 6x before the cloth leaves sanity (energy above
+ * its start by 2 % of m g L, or spanning more than 3 m while hanging from
+ * pins 1 m apart), so the state kept is a good one. Reported only: from 30x
+ * on, the first steps go wrong before any growth shows (at 1000x the very
+ * first step drops the cloth 1.3 m past its pins), so the guard stops it
+ * three or four steps in, finite but not sane. Before the guard, Verlet at
+ * 3x and more ran on for tens of steps to ~1e150 m before a position
+ * overflowed, and the state kept was an exploded cloth. */
 static uint64_t case_forced_steps(int32_t threads, int report)
 {
     const int32_t n = SANITIZED ? 10 : 16, steps = 400;
@@ -262,10 +267,11 @@ static uint64_t case_forced_steps(int32_t threads, int report)
         CHECK(wc_cloth_pin(w, c, pins, 2) == WC_OK, "pin");
         double dt = fmin(10.0, factor[k] * wc_world_stable_dt(w));
         double e0 = world_energy(w), scale = cloth_mass(w, c) * 9.81 * 1.0;
-        int s = 0, failed_at = -1, insane_at = -1;
+        int s = 0, failed_at = -1, insane_at = -1, by_guard = 0;
         for (s = 0; s < steps; ++s) {
             if (step(w, dt, "forced step") != WC_OK) {
                 failed_at = s;
+                by_guard = strstr(wc_world_last_error(w), "unstable") != NULL;
                 break;
             }
             if (insane_at < 0 && (world_energy(w) - e0 > 0.02 * scale || cloth_extent(w, c) > 3.0))
@@ -273,15 +279,24 @@ static uint64_t case_forced_steps(int32_t threads, int report)
         }
         if (report) {
             printf("forced step %gx stable (%.3g s): ", factor[k], dt);
-            if (insane_at >= 0)
-                printf("left sanity at step %d without an error (known gap), ", insane_at);
+            if (insane_at >= 0) printf("left sanity at step %d without an error, ", insane_at);
             if (failed_at >= 0)
-                printf("failed with %s at step %d, keeping a cloth that spans %.3g m\n",
-                       wc_status_name(WC_ERROR_NON_FINITE), failed_at, cloth_extent(w, c));
+                printf("failed at step %d %s, keeping a cloth that spans %.3g m: \"%.90s...\"\n",
+                       failed_at, by_guard ? "by the guard" : "(non-finite)", cloth_extent(w, c),
+                       wc_world_last_error(w));
             else
                 printf("%d steps without an error, cloth spans %.3g m\n", steps,
                        cloth_extent(w, c));
         }
+        if (factor[k] < 2.0)
+            CHECK(failed_at < 0, "forced step %gx: stable, but step %d failed: %s", factor[k],
+                  failed_at, wc_world_last_error(w));
+        else
+            CHECK(failed_at >= 0 && by_guard, "forced step %gx: %s", factor[k],
+                  failed_at < 0 ? "never failed" : "failed by overflow, not by the guard");
+        if (factor[k] > 2.0 && factor[k] < 10.0)
+            CHECK(insane_at < 0, "forced step %gx: left sanity at step %d before the guard stopped "
+                  "it at step %d", factor[k], insane_at, failed_at);
         h = h * 31u + world_hash(w);
         wc_world_destroy(w);
     }
