@@ -1,8 +1,8 @@
 /* Failure containment (issue 9): every allocation of the library goes
  * through the hook of wc_set_allocator(), and this test makes each one fail
  * in turn, during world creation, while adding cloths, colliders and pins,
- * and during steps that collide with mesh and convex colliders, self-collide
- * and stick wet cloth. Each failing call must return WC_ERROR_OUT_OF_MEMORY
+ * and during steps that collide with mesh and convex colliders, self-collide,
+ * collide two cloths with each other and stick wet cloth. Each failing call must return WC_ERROR_OUT_OF_MEMORY
  * with a message, free whatever it had allocated (the test tracks every
  * live block), change nothing (counts unchanged; a failing step keeps the
  * positions bitwise and the time), and the world must go on: retrying the
@@ -118,8 +118,11 @@ static wc_status op(scene *s, int k, const char **what)
         return wc_world_add_grid_cloth(s->w, &g, &s->grid);
     }
     case 2: {
-        *what = "wc_world_add_mesh_cloth (triangles)";
-        double v[3 * 4] = {-0.3, -0.3, 0.45, 0.3, -0.3, 0.45, 0.3, 0.3, 0.45, -0.3, 0.3, 0.45};
+        /* 4 mm over the grid cloth: within the thickness, so the two
+         * cloths collide with each other (cloth_group.c) from the first
+         * step, and its allocations fail in turn too */
+        *what = "wc_world_add_mesh_cloth (triangles, on the grid cloth)";
+        double v[3 * 4] = {-0.3, -0.3, 0.308, 0.3, -0.3, 0.308, 0.3, 0.3, 0.308, -0.3, 0.3, 0.308};
         int32_t f[6] = {0, 1, 2, 0, 2, 3};
         wc_mesh_cloth_def m = wc_mesh_cloth_def_default();
         m.vertices = v;
