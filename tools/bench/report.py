@@ -395,7 +395,8 @@ def hard_cases(program, lines):
     lines += ["## Hard cases", "",
               "tests/test_hard_cases.c (a ctest test; each case with its pass criterion: finite, a "
               "failed step keeps the last state, energy bounded, 0 intersections by the checker, "
-              "bitwise the same with 1 and 2 threads). Its output in this run:", ""]
+              "bitwise the same with 1 and 2 threads, and 4 for the two cloths). Its output in this "
+              "run:", ""]
     if not program or not os.path.exists(program):
         lines += [f"Skipped: no test_hard_cases program ({program}).", ""]
         return None
