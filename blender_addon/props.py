@@ -5,6 +5,7 @@ docs/python.md); the presets only fill them in.
 """
 
 import bpy
+import numpy as np
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty,
                        PointerProperty, StringProperty)
 
@@ -48,10 +49,6 @@ def _apply_preset(self, _context):
     finally:
         _applying_preset = False
 
-# Blender 4.5 warns about "//" paths unless the property says it takes them.
-_PATH_OPTIONS = ({"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set())
-
-
 def _material_edited(self, _context):
     # Editing a value by hand makes the material custom (like Blender's own
     # presets menu, which then shows no preset name).
@@ -61,7 +58,21 @@ def _material_edited(self, _context):
             self["preset"] = 4  # CUSTOM, set without running the update
 
 
+def _float32_within(lo, hi):
+    """The float32 limits inside the library's [lo, hi]. Blender keeps a
+    FloatProperty, and its limits, as 32-bit floats: a limit of 0.99 would be
+    kept as 0.99000001, which the library refuses."""
+    lo32, hi32 = np.float32(lo), np.float32(hi)
+    if lo32 < lo:
+        lo32 = np.nextafter(lo32, np.float32(np.inf))
+    if hi32 > hi:
+        hi32 = np.nextafter(hi32, np.float32(-np.inf))
+    return float(lo32), float(hi32)
+
+
 def _mat(name, description, default, min_, max_, unit_text, precision=3, step=1):
+    """A material value; [min_, max_] is the library's range (material.c)."""
+    min_, max_ = _float32_within(min_, max_)
     return FloatProperty(name=name, description="%s (%s)" % (description, unit_text),
                          default=default, min=min_, max=max_, precision=precision, step=step,
                          update=_material_edited)

@@ -1,6 +1,8 @@
 #include "material.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <string.h>
 
 #include "status.h"
 
@@ -29,9 +31,16 @@ static wc_status check_range(wc_message *msg, const char *field, double value, d
 {
     int ok = isfinite(value) && (lo_open ? value > lo : value >= lo) && value <= hi;
     if (ok) return WC_OK;
+    /* A value just past a bound (0.99 kept as a 32-bit float is 0.99000001)
+     * would print as the bound itself with %g; then print all its digits. */
+    double bound = value > hi ? hi : lo;
+    char a[32], b[32];
+    snprintf(a, sizeof a, "%g", value);
+    snprintf(b, sizeof b, "%g", bound);
+    int digits = strcmp(a, b) == 0 ? 17 : 6;
     return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
-                   "material.%s must be in %s%g, %g] but is %g", field, lo_open ? "(" : "[",
-                   lo, hi, value);
+                   "material.%s must be in %s%g, %g] but is %.*g", field, lo_open ? "(" : "[",
+                   lo, hi, digits, value);
 }
 
 wc_status wc_material_validate(const wc_material *m, wc_message *msg)

@@ -192,6 +192,14 @@ static void test_material(void)
         m.material = g.material;
         expect(wc_world_add_mesh_cloth(wa, &m, &id), WC_ERROR_INVALID_ARGUMENT, call, cases[i].field, NULL);
     }
+    /* A value just past a bound must not print as the bound ("must be in
+     * [0, 0.99] but is 0.99"): 0.99 kept as a 32-bit float, as Blender keeps
+     * its properties, is 0.99000000953674316. */
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = 4;
+    g.material.wet_softening = (double)0.99f;
+    expect(wc_world_add_grid_cloth(wa, &g, &id), WC_ERROR_INVALID_ARGUMENT, "material.wet_softening = 0.99f",
+           "0.99] but is 0.99000000953674316", NULL);
     CHECK(wc_world_cloth_count(wa) == 1, "a failed add created a cloth (%d)", wc_world_cloth_count(wa));
 }
 
