@@ -34,12 +34,17 @@ def uv_sphere(radius=0.3, segments=16, rings=8):
     return np.array(v, float), np.array(t, np.int32)
 
 
-def drape(n, integrator="verlet", wet=False, self_collision=False, threads=1):
+def drape(n, integrator="verlet", wet=False, self_collision=False, threads=1, smooth=False):
     """The thesis drape: n x n grid cloth, 1 m, 0.6 m above the 114-vertex
-    UV sphere of radius 0.3 m (Table 3.2's scene); wet = soaked (w = 1)."""
+    UV sphere of radius 0.3 m (Table 3.2's scene); wet = soaked (w = 1).
+    smooth: the analytic sphere of the same radius (a convex collider)
+    instead of the mesh, the control for the mesh's facets."""
     w = wetcloth.World(integrator=integrator, threads=threads)
-    v, t = uv_sphere()
-    w.add_mesh_collider(v, t)
+    if smooth:
+        w.add_sphere((0.0, 0.0, 0.0), 0.3)
+    else:
+        v, t = uv_sphere()
+        w.add_mesh_collider(v, t)
     c = w.add_grid_cloth(n, n, center=(0.0, 0.0, 0.6), wetness=1.0 if wet else 0.0,
                          self_collision=self_collision)
     return w, c
@@ -70,4 +75,8 @@ SCENES = {
     "drape_dry": lambda n, integ: drape(n, integ, wet=False),
     "drape_wet": lambda n, integ: drape(n, integ, wet=True),
     "hanging": lambda n, integ: hanging(n, integ),
+    "drape_dry_smooth": lambda n, integ: drape(n, integ, wet=False, smooth=True),
 }
+"""Scenes of the speed-against-error section; the last is a control (Verlet
+only): the dry drape onto the analytic sphere instead of the mesh."""
+CONTROLS = ("drape_dry_smooth",)
