@@ -65,12 +65,26 @@ def load():
     return " ".join(open("/proc/loadavg").read().split()[:3])
 
 
-def run_scene(make, n, integrator, substeps, frames, perturb=0.0, touch=None):
+def first_contact_frame(make, n, substeps, frames):
+    """First frame (0-based) during which any step of a Verlet run at
+    `substeps` per frame has a collider contact, or None."""
+    w, _ = make(n, "verlet")
+    try:
+        for f in range(frames):
+            for _ in range(substeps):
+                w.step(scenes.FRAME / substeps)
+                if w.stats["collider_contacts"]:
+                    return f
+    finally:
+        w.close()
+    return None
+
+
+def run_scene(make, n, integrator, substeps, frames, perturb=0.0):
     """Runs a scene; returns (positions per frame, wall s per simulated s,
     substeps per frame, error message or None). substeps 0 = automatic.
     perturb: every initial position moved by a random offset of this size
-    per coordinate, m (fixed seed), for the scene's noise floor. touch: a
-    list that gets the first frame whose last step had a collider contact."""
+    per coordinate, m (fixed seed), for the scene's noise floor."""
     w, c = make(n, integrator)
     if perturb:
         p = c.positions
@@ -82,8 +96,6 @@ def run_scene(make, n, integrator, substeps, frames, perturb=0.0, touch=None):
             used = w.advance(scenes.FRAME, substeps)
             wall += time.perf_counter() - t0
             out.append(c.positions)
-            if touch is not None and not touch and w.stats["collider_contacts"]:
-                touch.append(len(out) - 1)
     except wetcloth.WetclothError as e:
         w.close()
         return None, None, substeps, str(e).split(";")[0]
@@ -140,9 +152,8 @@ def speed_vs_error(out, quick, lines):
     results = {}
     for name, make in scenes.SCENES.items():
         _, _, auto, _ = run_scene(make, n, "verlet", 0, 1)
-        touch = []
-        ref, ref_cost, _, err = run_scene(make, n, "verlet", 8 * auto, frames, touch=touch)
-        contact = touch[0] if touch else None
+        ref, ref_cost, _, err = run_scene(make, n, "verlet", 8 * auto, frames)
+        contact = first_contact_frame(make, n, 8 * auto, frames)
         if err:
             raise SystemExit(f"{name}: the reference run failed: {err}")
         # The noise floor: the same run from initial positions moved by
@@ -197,8 +208,9 @@ def speed_vs_error(out, quick, lines):
                   f"{floor_ref:.2e} (the runs part by more than 1e-6 m {frame_text(part_ref)})"
                   + (f", default setting {floor_default:.2e} ({frame_text(part_default)})"
                      if floor_default is not None else "") + ". "
-                  + (f"The cloth first touches the collider at frame {contact} (of the reference); "
-                     "the error is also given over the frames before and from it on."
+                  + (f"The cloth first touches the collider during frame {contact} (0-based, "
+                     "in the reference run); the error is also given over the frames before "
+                     "it and from it on."
                      if contact is not None else "No collider contact."), "",
                   "| integrator | substeps/frame | step, s | error / size | before contact "
                   "| from contact on | wall s per sim. s | note |",
