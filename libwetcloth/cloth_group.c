@@ -27,7 +27,16 @@ struct wc_cloth_group {
     int32_t world_cloths;
     uint8_t *handled;
     /// The combined cloth: only what collision reads (see selfcollide.c).
+    /// Its adhesive pairs are the wet pairs between different members
+    /// (wetness.c), in combined numbering.
     wc_cloth combined;
+    /// Those pairs as wc_cloth_group_save found them, for
+    /// wc_cloth_group_restore.
+    int32_t *saved_pairs;
+    double *saved_data;
+    int64_t saved_count, saved_capacity;
+    /// Per member, for the adhesion between members.
+    wc_wet_piece *pieces;
 };
 
 static void double_fields(wc_cloth *c, double **out[DOUBLE_FIELDS])
@@ -64,9 +73,11 @@ void wc_cloth_group_destroy(wc_cloth_group *g)
     wc_free(c->pin_slot);
     wc_free(c->topology.triangles);
     wc_free(c->self_touched);
+    wc_free(c->adhesive_pairs);
+    wc_free(c->adhesive_data);
     wc_self_state_destroy(c->self);
     void *blocks[] = {g->member, g->first, g->first_triangle, g->self, g->friction,
-                      g->wet_friction, g->handled};
+                      g->wet_friction, g->handled, g->saved_pairs, g->saved_data, g->pieces};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
     wc_free(g);
 }
@@ -85,8 +96,9 @@ static int allocate(wc_cloth_group *g, wc_cloth *const *cloths, int32_t cloth_co
     g->friction = wc_alloc_array((size_t)m, sizeof *g->friction);
     g->wet_friction = wc_alloc_array((size_t)m, sizeof *g->wet_friction);
     g->handled = wc_alloc_array((size_t)cloth_count, 1);
+    g->pieces = wc_alloc_array((size_t)m, sizeof *g->pieces);
     if (!g->member || !g->first || !g->first_triangle || !g->self || !g->friction ||
-        !g->wet_friction || !g->handled)
+        !g->wet_friction || !g->handled || !g->pieces)
         return 0;
     for (int32_t c = 0, k = 0; c < cloth_count; ++c) {
         const wc_cloth *cl = cloths[c];
@@ -228,27 +240,83 @@ static int32_t member_of(const wc_cloth_group *g, int32_t i)
 
 /* Self-adhesion: the vertex-face pairs the combined pass answered within
  * one wet self-colliding member go to that member, which keeps its
- * adhesive pairs as it would alone. Pairs between two cloths are dropped:
- * wet adhesion between different cloths is not modelled. */
+ * adhesive pairs as it would alone. Those between two members stay with
+ * the combined cloth, which keeps them the same way (wc_wet_self_pairs: the
+ * answered ones and last step's still within the hold band), so that wet
+ * cloths stick to each other (wc_cloth_group_adhesion). */
 static wc_status hand_out_adhesion(wc_cloth_group *g, wc_cloth *const *cloths, double h)
 {
     wc_cloth *comb = &g->combined;
     int failed = comb->self_touched_failed;
+    int64_t across = 0;
     for (int64_t p = 0; p < comb->self_touched_count && !failed; ++p) {
         int32_t v = comb->self_touched[2 * p], t = comb->self_touched[2 * p + 1];
         int32_t k = member_of(g, v);
         wc_cloth *cl = cloths[g->member[k]];
-        if (member_of(g, comb->topology.triangles[3 * (size_t)t]) != k || !cl->self || !cl->wet_forces)
-            continue;
-        wc_wet_note_self_contact(cl, v - g->first[k], t - g->first_triangle[k]);
+        if (member_of(g, comb->topology.triangles[3 * (size_t)t]) != k) {
+            comb->self_touched[2 * across] = v, comb->self_touched[2 * across + 1] = t;
+            ++across;
+        } else if (cl->self && cl->wet_forces) {
+            wc_wet_note_self_contact(cl, v - g->first[k], t - g->first_triangle[k]);
+        }
     }
-    comb->self_touched_count = 0, comb->self_touched_failed = 0;
+    comb->self_touched_count = failed ? 0 : across, comb->self_touched_failed = 0;
     if (failed) return WC_ERROR_OUT_OF_MEMORY;
     for (int32_t k = 0; k < g->count; ++k) {
         wc_cloth *cl = cloths[g->member[k]];
         if (cl->self && cl->wet_forces && wc_wet_self_pairs(cl, h)) return WC_ERROR_OUT_OF_MEMORY;
     }
-    return WC_OK;
+    return wc_wet_self_pairs(comb, h);
+}
+
+int wc_cloth_group_save(wc_cloth_group *g)
+{
+    if (!g) return 0;
+    const wc_cloth *comb = &g->combined;
+    int64_t n = comb->adhesive_count;
+    if (n > g->saved_capacity) {
+        int32_t *pairs = wc_alloc_array((size_t)n, 2 * sizeof *pairs);
+        double *data = wc_alloc_array((size_t)n, 6 * sizeof *data);
+        if (!pairs || !data) {
+            wc_free(pairs), wc_free(data);
+            return 1;
+        }
+        wc_free(g->saved_pairs), wc_free(g->saved_data);
+        g->saved_pairs = pairs, g->saved_data = data, g->saved_capacity = n;
+    }
+    if (n) {
+        memcpy(g->saved_pairs, comb->adhesive_pairs, (size_t)n * 2 * sizeof *g->saved_pairs);
+        memcpy(g->saved_data, comb->adhesive_data, (size_t)n * 6 * sizeof *g->saved_data);
+    }
+    g->saved_count = n;
+    return 0;
+}
+
+void wc_cloth_group_restore(wc_cloth_group *g)
+{
+    if (!g) return;
+    wc_cloth *comb = &g->combined;
+    /* the pair buffers only grow, so the saved pairs still fit */
+    if (g->saved_count) {
+        memcpy(comb->adhesive_pairs, g->saved_pairs, (size_t)g->saved_count * 2 * sizeof *g->saved_pairs);
+        memcpy(comb->adhesive_data, g->saved_data, (size_t)g->saved_count * 6 * sizeof *g->saved_data);
+    }
+    comb->adhesive_count = g->saved_count;
+    comb->self_touched_count = 0, comb->self_touched_failed = 0;
+}
+
+void wc_cloth_group_adhesion(wc_cloth_group *g, wc_cloth *const *cloths)
+{
+    if (!g || g->combined.adhesive_count == 0) return;
+    for (int32_t k = 0; k < g->count; ++k) {
+        wc_cloth *cl = cloths[g->member[k]];
+        wc_wet_piece piece = {cl->wetness, cl->topology.area, cl->material.adhesion,
+                              cl->fx, cl->fy, cl->fz, g->first[k]};
+        g->pieces[k] = piece;
+    }
+    const wc_cloth *comb = &g->combined;
+    wc_wet_pair_adhesion(comb->adhesive_pairs, comb->adhesive_data, comb->adhesive_count,
+                         comb->topology.triangles, g->pieces, g->count);
 }
 
 wc_status wc_cloth_group_collide(wc_cloth_group *g, wc_cloth *const *cloths, double dt,
@@ -267,9 +335,13 @@ wc_status wc_cloth_group_collide(wc_cloth_group *g, wc_cloth *const *cloths, dou
         g->wet_friction[k] = cl->material.wet_friction;
     }
     double h = wc_self_thickness(comb);
-    if (!members_meet(g, cloths, h)) {
+    /* pairs between dry members do not pull; adhering ones hold within the
+     * band, so while there are any the pass runs within the band too */
+    if (!comb->wet_forces) comb->adhesive_count = 0;
+    if (!members_meet(g, cloths, comb->adhesive_count ? (1.0 + WC_WET_HOLD_BAND) * h : h)) {
         /* the candidates were made for motions of an earlier step */
         wc_self_state_invalidate(comb->self);
+        comb->adhesive_count = 0;
         return WC_OK;
     }
     wc_self_state_set_friction(comb->self, g->friction, g->wet_friction);

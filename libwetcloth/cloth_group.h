@@ -31,11 +31,30 @@ void wc_cloth_group_destroy(wc_cloth_group *group);
 /// come within the group's thickness, resolves the collisions of all
 /// members together (moves nx, sets history overrides and contacts as the
 /// self-collision does; records and updates the self-adhesion of wet
-/// self-colliding members), and marks them handled; otherwise marks none.
+/// self-colliding members, and the wet pairs between members), and marks
+/// them handled; otherwise marks none.
 /// Deterministic for any thread count. WC_ERROR_OUT_OF_MEMORY on
 /// out-of-memory (the caller restores the contact state).
 wc_status wc_cloth_group_collide(wc_cloth_group *group, wc_cloth *const *cloths, double dt,
                                  int threads, wc_step_stats *stats);
+
+/// Before a step's collisions, with the members' contact state
+/// (contact_backup.h): keeps the wet pairs between members for
+/// wc_cloth_group_restore. Non-zero on out-of-memory, nothing changed.
+/// Nothing to copy without such pairs. NULL is a no-op.
+int wc_cloth_group_save(wc_cloth_group *group);
+
+/// After the collisions of a step failed: the wet pairs between members as
+/// wc_cloth_group_save found them (the members' own state is put back by
+/// contact_backup.h). NULL is a no-op.
+void wc_cloth_group_restore(wc_cloth_group *group);
+
+/// Adds the wet adhesion between members (the pairs the last collision
+/// kept, wetness.c's self-adhesion law across cloths) to their fx, fy, fz:
+/// equal and opposite, serial in pair order, so the sums do not depend on
+/// the thread count. Nothing to do, and no cost, without such pairs (no
+/// member wet, or none touching another). NULL is a no-op.
+void wc_cloth_group_adhesion(wc_cloth_group *group, wc_cloth *const *cloths);
 
 /// Whether the last wc_cloth_group_collide resolved cloth `cloth` (a world
 /// index): then its own self-collision must not run in that step.

@@ -86,7 +86,9 @@ void wc_wet_forces(wc_cloth *c, int threads)
  * has on a collider. Pairs are kept, like collider contacts, while they
  * stay within (1 + WC_WET_HOLD_BAND) h. Rest neighbours in the cloth (pairs
  * closer than 2 h in the rest shape) never adhere: they are the cloth
- * itself, not a second layer. */
+ * itself, not a second layer. Between different cloths of a group the same
+ * law acts on the pairs the group's collision answered (cloth_group.c),
+ * with each side's own adhesion and wetness (wc_wet_pair_adhesion). */
 
 void wc_wet_note_self_contact(wc_cloth *c, int32_t v, int32_t t)
 {
@@ -168,24 +170,57 @@ wc_status wc_wet_self_pairs(wc_cloth *c, double h)
 
 void wc_wet_self_adhesion(const wc_cloth *c, double *fx, double *fy, double *fz)
 {
-    const wc_material *m = &c->material;
-    for (int64_t k = 0; k < c->adhesive_count;) {
+    wc_wet_piece whole = {c->wetness, c->topology.area, c->material.adhesion, fx, fy, fz, 0};
+    wc_wet_pair_adhesion(c->adhesive_pairs, c->adhesive_data, c->adhesive_count,
+                         c->topology.triangles, &whole, 1);
+}
+
+/* Piece of particle i (pieces ascending by first). */
+static const wc_wet_piece *piece_of(const wc_wet_piece *pieces, int32_t count, int32_t i)
+{
+    int32_t lo = 0, hi = count - 1;
+    while (lo < hi) {
+        int32_t mid = (lo + hi + 1) / 2;
+        if (pieces[mid].first <= i) lo = mid;
+        else hi = mid - 1;
+    }
+    return pieces + lo;
+}
+
+/* Between two cloths the pull is the larger of the two sides' adhesion
+ * pressures a w: the water film in the gap is the wetter side's, and it
+ * pulls as that cloth's film would (a soaked cloth on a dry one sticks as
+ * it does to a dry collider, where only its own a w counts). Within one
+ * cloth a is the same on both sides and this is a max(w_v, w_f), the rule
+ * above; no combination (mean, product) keeps both that and the collider
+ * case. */
+void wc_wet_pair_adhesion(const int32_t *pairs, const double *data, int64_t count,
+                          const int32_t *triangles, const wc_wet_piece *pieces,
+                          int32_t piece_count)
+{
+    for (int64_t k = 0; k < count;) {
         /* the pairs of one vertex are consecutive (sorted by vertex) */
-        int32_t v = c->adhesive_pairs[2 * k];
+        int32_t v = pairs[2 * k];
         int64_t end = k;
-        while (end < c->adhesive_count && c->adhesive_pairs[2 * end] == v) ++end;
-        double share = 0.5 * m->adhesion * c->topology.area[v] / (double)(end - k);
+        while (end < count && pairs[2 * end] == v) ++end;
+        const wc_wet_piece *pv = piece_of(pieces, piece_count, v);
+        int32_t lv = v - pv->first;
+        double share = 0.5 * pv->area[lv] / (double)(end - k);
+        double vertex_pull = pv->adhesion * pv->wetness[lv];
         for (; k < end; ++k) {
-            const int32_t *tri = c->topology.triangles + 3 * (size_t)c->adhesive_pairs[2 * k + 1];
-            const double *b = c->adhesive_data + 6 * k, *n = b + 3;
-            double face_w = b[0] * c->wetness[tri[0]] + b[1] * c->wetness[tri[1]] + b[2] * c->wetness[tri[2]];
-            double f = share * (c->wetness[v] > face_w ? c->wetness[v] : face_w);
+            const int32_t *tri = triangles + 3 * (size_t)pairs[2 * k + 1];
+            const wc_wet_piece *pf = piece_of(pieces, piece_count, tri[0]);
+            const double *b = data + 6 * k, *n = b + 3;
+            double face_w = 0.0;
+            for (int j = 0; j < 3; ++j) face_w += b[j] * pf->wetness[tri[j] - pf->first];
+            double face_pull = pf->adhesion * face_w;
+            double f = share * (vertex_pull > face_pull ? vertex_pull : face_pull);
             if (!(f > 0.0)) continue;
             /* (pinned particles ignore their force at integration) */
-            fx[v] -= f * n[0], fy[v] -= f * n[1], fz[v] -= f * n[2];
+            pv->fx[lv] -= f * n[0], pv->fy[lv] -= f * n[1], pv->fz[lv] -= f * n[2];
             for (int j = 0; j < 3; ++j) {
-                int32_t i = tri[j];
-                fx[i] += f * b[j] * n[0], fy[i] += f * b[j] * n[1], fz[i] += f * b[j] * n[2];
+                int32_t i = tri[j] - pf->first;
+                pf->fx[i] += f * b[j] * n[0], pf->fy[i] += f * b[j] * n[1], pf->fz[i] += f * b[j] * n[2];
             }
         }
     }

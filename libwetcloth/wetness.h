@@ -45,6 +45,30 @@ wc_status wc_wet_self_pairs(wc_cloth *cloth, double h);
 /// order, so the sums do not depend on the thread count.
 void wc_wet_self_adhesion(const wc_cloth *cloth, double *fx, double *fy, double *fz);
 
+/// One cloth's share of a list of adhesive pairs whose indices run over
+/// several cloths (the cloth group's combined cloth, cloth_group.h): its
+/// wetness and area shares, its adhesion pressure, the force arrays its
+/// pulls go to, and where its particles and triangles start in the pairs'
+/// numbering.
+typedef struct wc_wet_piece {
+    const double *wetness, *area;
+    /// Adhesion pressure, Pa (the cloth's material.adhesion).
+    double adhesion;
+    double *fx, *fy, *fz;
+    int32_t first;
+} wc_wet_piece;
+
+/// The self-adhesion law over pairs that may join different pieces: pairs
+/// (vertex, triangle) and their data as in wc_cloth (adhesive_pairs,
+/// adhesive_data), sorted by vertex; triangles (3 per triangle) in the same
+/// numbering; pieces ascending by first. Per pair F = A_v / 2 / n_v *
+/// max(a_v w_v, a_f w_f) (a the pieces' adhesion, w_f the face point's
+/// wetness), -F n on the vertex and +F b_k n on the corners. Serial, in
+/// pair order.
+void wc_wet_pair_adhesion(const int32_t *pairs, const double *data, int64_t count,
+                          const int32_t *triangles, const wc_wet_piece *pieces,
+                          int32_t piece_count);
+
 /// After the collisions of a step: marks the stuck particles (wet, in
 /// contact in this step and the one before) and returns their count.
 int32_t wc_wet_mark_stuck(wc_cloth *cloth);

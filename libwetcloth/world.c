@@ -265,6 +265,8 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
         wc_forces_compute(w->cloths[c], w->def.gravity, threads);
         if (w->cloths[c]->wet_forces) wc_wet_forces(w->cloths[c], threads);
     }
+    /* wet cloths sticking to each other: after every cloth's own forces */
+    wc_cloth_group_adhesion(w->group, w->cloths);
     t1 = wc_clock_seconds(), phase[0] += t1 - t0, t0 = t1;
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_status s = integrate_cloth(w, c, dt, pin_fraction, threads);
@@ -277,13 +279,15 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
     if (colliding) {
         /* collision changes contacts before it knows it will succeed: a
          * failed step puts them back (contact_backup.h) */
-        if (wc_contact_backup_save(&w->backup, w->cloths, w->cloth_count))
+        if (wc_contact_backup_save(&w->backup, w->cloths, w->cloth_count) ||
+            wc_cloth_group_save(w->group))
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory saving the contact state; the world keeps its last "
                            "good state");
         s = collide(w, dt, share, threads);
         if (s) {
             wc_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
+            wc_cloth_group_restore(w->group);
             return s;
         }
     }

@@ -147,3 +147,13 @@ int scene_count_near_sphere(const wc_world *w, int32_t cloth, double radius, dou
     free(p), free(d);
     return near;
 }
+
+int scene_intersections(const wc_world *w)
+{
+    wc_intersection_counts c;
+    if (wc_world_count_intersections(w, &c) != WC_OK) {
+        fprintf(stderr, "wc_world_count_intersections: %s\n", wc_world_last_error(w));
+        return 1000000;
+    }
+    return c.cloth_cloth + c.cloth_collider;
+}

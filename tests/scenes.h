@@ -40,6 +40,10 @@ int scene_count_near_sphere(const wc_world *world, int32_t cloth, double radius,
 void scene_distances_to_mesh(const double *points, int32_t count, const double *vertices,
                              const int32_t *triangles, int32_t triangle_count, double *out);
 
+/// Intersections in the world by the independent checker (cloth-cloth plus
+/// cloth-collider); on an error prints it and returns 1000000, which fails
+/// any check for none.
+int scene_intersections(const wc_world *world);
 /// FNV-1a hash of a cloth's positions (bitwise).
 uint64_t scene_hash_positions(const wc_world *world, int32_t cloth);
 

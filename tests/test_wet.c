@@ -73,13 +73,6 @@ static int count_stuck(const wc_world *w, int32_t cloth)
     return count;
 }
 
-static int intersections(const wc_world *w)
-{
-    wc_intersection_counts c;
-    CHECK(wc_world_count_intersections(w, &c) == WC_OK, "%s", wc_world_last_error(w));
-    return c.cloth_cloth + c.cloth_collider;
-}
-
 /* ------------------------------------------------------------------------ */
 /* 1. Dry is exactly the plain model                                        */
 /* ------------------------------------------------------------------------ */
@@ -196,7 +189,7 @@ static wrap_result wrap_run(double wetness)
                 r.steps++;
             }
         }
-        r.intersections += intersections(w);
+        r.intersections += scene_intersections(w);
         wc_cloth_get_positions(w, cl, p, 400);
         double edge = 0.0;
         for (int i = 0; i < 20; ++i) edge += hypot(p[3 * i], p[3 * i + 1]) / 20;
@@ -313,7 +306,7 @@ static spread_result spread_run(double adhesion, double bend)
         r.count[f] = count_stuck(w, cl);
         r.stats_mismatch += r.count[f] != wc_world_get_stats(w).stuck_particles;
     }
-    r.intersections = intersections(w);
+    r.intersections = scene_intersections(w);
     wc_world_destroy(w);
     return r;
 }
@@ -461,7 +454,7 @@ static slack_result slack_run(double wetness)
         r.bottom_drift += (p[3 * i] - p0[3 * i]) / n / D;
         r.bottom_stuck_after += stuck[i];
     }
-    r.intersections = intersections(w);
+    r.intersections = scene_intersections(w);
     wc_world_destroy(w);
     return r;
 }
@@ -556,7 +549,7 @@ static fold_result fold_run(double wetness)
             r.stuck_ends += stuck[i];
         }
     }
-    r.intersections = intersections(w);
+    r.intersections = scene_intersections(w);
     wc_world_destroy(w);
     return r;
 }
@@ -715,7 +708,7 @@ static self_result self_run(double wetness)
     memset(&r, 0, sizeof r);
     for (int f = 0; f < 12; ++f) {
         advance_or_fail(w, 1.0 / 24, 0);
-        r.intersections += intersections(w);
+        r.intersections += scene_intersections(w);
         if (f == 0) {
             /* the self-adhesion forces the next step will apply */
             const wc_cloth *c = w->cloths[cl];
@@ -815,7 +808,7 @@ static double self_slide_run(double q)
     int crossings = 0;
     for (int f = 0; f < 3; ++f) {
         advance_or_fail(w, 1.0 / 30, 0);
-        crossings += intersections(w);
+        crossings += scene_intersections(w);
     }
     CHECK(crossings == 0, "%d intersections", crossings);
     wc_cloth_get_velocities(w, cl, v, N);
