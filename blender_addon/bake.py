@@ -1,6 +1,8 @@
 """Baking: reads the Blender scene, runs libwetcloth through the `wetcloth`
 package frame by frame, writes a PC2 cache and hooks up a Mesh Cache
-modifier. No physics here: every position comes from the library.
+modifier. No physics here: every position comes from the library. One bake
+is one library world: of one object (Bake), or of every Wet Cloth object
+together (Bake All), where the library collides them with each other.
 
 Coordinates: the simulation runs in world space (1 Blender unit = 1 m);
 the cache holds object-local coordinates, so the baked motion plays back
@@ -139,11 +141,13 @@ def _is_collider(o):
             any(m.type == "COLLISION" and m.show_viewport for m in o.modifiers))
 
 
-def find_colliders(scene, view_layer, settings, cloth_ob):
+def find_colliders(scene, view_layer, settings, cloth_objects):
+    """The colliders of a cloth with these settings: objects with Collision
+    physics (in its collection, if set) that are not cloths of the bake."""
     pool = (settings.collision_collection.all_objects if settings.collision_collection
             else scene.objects)
     return [o for o in pool
-            if o is not cloth_ob and _is_collider(o) and view_layer.objects.get(o.name) == o]
+            if o not in cloth_objects and _is_collider(o) and view_layer.objects.get(o.name) == o]
 
 
 def _evaluated_mesh(ob, depsgraph, matrix=None):
@@ -190,28 +194,30 @@ def _check_folder(folder):
 # ---------------------------------------------------------------------------
 # The bake
 
+def _world_settings(settings, scene):
+    """The settings of one object that belong to the world, not to its cloth,
+    as (name, value) pairs: every object of a bake together must agree on
+    them."""
+    substeps = "automatic" if settings.substeps_auto else settings.substeps
+    return (("frame range", "%d to %d" % props.frame_range(settings, scene)),
+            ("integrator", settings.integrator),
+            ("substeps", substeps))
 
-class Baker:
-    """One bake of one object: start(), step() until done, then finish();
-    abort() at any point leaves the previous bake as it was."""
 
-    def __init__(self, context, ob):
-        self.scene = context.scene
-        self.view_layer = context.view_layer
+class _ClothPart:
+    """One object's part of a bake: its cloth in the world, its pins, its
+    cache being written."""
+
+    def __init__(self, ob):
         self.ob = ob
         self.settings = ob.wet_cloth
-        self.world = None
         self.writer = None
         self.tmp_path = None
         self.hidden_modifiers = []
-        self.frame_before = self.scene.frame_current
-        self.done = False
-        self.started = time.perf_counter()
 
-    # setup ------------------------------------------------------------------
-
-    def start(self):
-        ob, s, scene = self.ob, self.settings, self.scene
+    def check(self, scene):
+        """What can be checked before anything is made; BakeError if not."""
+        ob, s = self.ob, self.settings
         if ob.type != "MESH":
             raise BakeError("%s is not a mesh (it is a %s): Wet Cloth bakes mesh objects"
                             % (ob.name, ob.type.lower()))
@@ -221,79 +227,53 @@ class Baker:
         mesh = ob.data
         if len(mesh.polygons) == 0:
             raise BakeError("%s has no faces: a cloth needs a mesh with faces" % ob.name)
-        self.start_frame, self.end_frame = props.frame_range(s, scene)
-        if self.end_frame <= self.start_frame:
+        start, end = props.frame_range(s, scene)
+        if end <= start:
             raise BakeError("the frame range %d to %d is empty: the end must come after the "
-                            "start" % (self.start_frame, self.end_frame))
-        self.frame_count = self.end_frame - self.start_frame + 1
-        self.frame = self.start_frame
-        self.frame_dt = scene.render.fps_base / scene.render.fps
+                            "start" % (start, end))
         self.given_dir, self.folder, self.path = cache_paths(ob, s)
-
         n = len(mesh.vertices)
-        faces = cloth_faces(mesh)
-        wet = np.full(n, float(s.wetness))
+        self.faces = cloth_faces(mesh)
+        self.wet = np.full(n, float(s.wetness))
         if s.wetness_group:
-            wet *= np.clip(group_weights(ob, s.wetness_group), 0.0, 1.0)
+            self.wet *= np.clip(group_weights(ob, s.wetness_group), 0.0, 1.0)
         self.pins = (np.flatnonzero(group_weights(ob, s.pin_group) > 0.0).astype(np.int32)
                      if s.pin_group else np.zeros(0, np.int32))
 
-        self.colliders = []
-        if s.use_colliders:
-            self.colliders = find_colliders(scene, self.view_layer, s, ob)
-            if not self.colliders:
-                where = ("in the collection %r" % s.collision_collection.name
-                         if s.collision_collection else "in the scene")
-                raise BakeError("nothing to collide with: no object %s has Collision physics; "
-                                "add it to an object (Physics > Collision) or turn off Object "
-                                "Collisions" % where)
-        _check_folder(self.folder)
+    def find_colliders(self, scene, view_layer, cloth_objects):
+        """The objects this cloth collides with (none when Object Collisions
+        is off); BakeError if it is on and there are none."""
+        s = self.settings
+        if not s.use_colliders:
+            return []
+        found = find_colliders(scene, view_layer, s, cloth_objects)
+        if not found:
+            where = ("in the collection %r" % s.collision_collection.name
+                     if s.collision_collection else "in the scene")
+            raise BakeError("nothing to collide with: no object %s has Collision physics; "
+                            "add it to an object (Physics > Collision) or turn off Object "
+                            "Collisions" % where)
+        return found
 
-        wetcloth = load_wetcloth()
-        self.wetcloth = wetcloth
+    def add_to(self, world, wetcloth, start_world, collide_with_cloths):
+        s = self.settings
         material = wetcloth.Material(**props.material_kwargs(s))
+        self.cloth = world.add_cloth(start_world, self.faces, material=material,
+                                     wetness=self.wet, self_collision=s.self_collision,
+                                     collide_with_cloths=collide_with_cloths)
+        if self.pins.size:
+            self.cloth.pin(self.pins)
 
-        # The cloth's own motion (pins) is read from the mesh as evaluated
-        # without this add-on's cache and what comes after it.
-        self._hide_cache_modifiers()
-        scene.frame_set(self.start_frame)
-        depsgraph = self._depsgraph()
-        start_world = self._cloth_world_positions(depsgraph)
-
-        gravity = tuple(scene.gravity) if scene.use_gravity else (0.0, 0.0, 0.0)
-        try:
-            self.world = wetcloth.World(gravity=gravity,
-                                        integrator=props.integrator_name(s))
-            self.cloth = self.world.add_cloth(start_world, faces, material=material,
-                                              wetness=wet, self_collision=s.self_collision)
-            if self.pins.size:
-                self.cloth.pin(self.pins)
-            self.sim_colliders = []
-            for o in self.colliders:
-                v, t = _evaluated_mesh(o, depsgraph)
-                if t.shape[0] == 0:
-                    raise BakeError("collider %s has no faces" % o.name)
-                c = o.collision
-                self.sim_colliders.append(self.world.add_mesh_collider(
-                    v, t, thickness=float(c.thickness_outer),
-                    friction=min(10.0, float(c.cloth_friction) / 10.0)))
-        except wetcloth.WetclothError as e:
-            raise BakeError(str(e)) from None
-
+    def open_cache(self, wetcloth, frame_count, start_frame):
         self.tmp_path = os.path.join(self.folder, ".%s.%d.tmp" % (os.path.basename(self.path),
                                                                   os.getpid()))
         try:
-            self.writer = wetcloth.meshio.PC2Writer(self.tmp_path, n, self.frame_count,
-                                                    start=float(self.start_frame))
+            self.writer = wetcloth.meshio.PC2Writer(self.tmp_path, len(self.ob.data.vertices),
+                                                    frame_count, start=float(start_frame))
         except OSError as e:
             raise BakeError("cannot write the cache %s: %s" % (self.tmp_path, e.strerror or e))
-        self._write_frame(start_world, self.ob.matrix_world)
-        self.substeps = 0
 
-    def _depsgraph(self):
-        return bpy.context.evaluated_depsgraph_get()
-
-    def _hide_cache_modifiers(self):
+    def hide_cache_modifiers(self):
         mods = list(self.ob.modifiers)
         for i, m in enumerate(mods):
             if m.type == "MESH_CACHE" and m.name == MODIFIER_NAME:
@@ -303,14 +283,15 @@ class Baker:
                         self.hidden_modifiers.append(later.name)
                 break
 
-    def _restore_modifiers(self):
+    def restore_modifiers(self):
         for name in self.hidden_modifiers:
             m = self.ob.modifiers.get(name)
             if m is not None:
                 m.show_viewport = True
         self.hidden_modifiers = []
 
-    def _cloth_world_positions(self, depsgraph):
+    def world_positions(self, depsgraph):
+        """The evaluated mesh in world space (its pins' motion); sets matrix."""
         ev = self.ob.evaluated_get(depsgraph)
         n = len(self.ob.data.vertices)
         mesh = ev.to_mesh()
@@ -327,9 +308,189 @@ class Baker:
         self.matrix = _matrix(ev.matrix_world)
         return _to_world(v, self.matrix)
 
-    def _write_frame(self, world_positions, matrix):
-        local = _to_local(world_positions, _matrix(matrix))
-        self.writer.write(local)
+    def follow(self, depsgraph):
+        """The pins' targets (or the object's transform) at the new frame."""
+        if self.pins.size:
+            self.cloth.set_pin_targets(self.world_positions(depsgraph)[self.pins])
+        else:
+            self.matrix = _matrix(self.ob.evaluated_get(depsgraph).matrix_world)
+
+    def write_frame(self, world_positions, matrix=None):
+        self.writer.write(_to_local(world_positions,
+                                    self.matrix if matrix is None else _matrix(matrix)))
+
+    def take_cache(self):
+        """Closes the new cache and puts it in place of the previous one."""
+        s = self.settings
+        self.writer.close()
+        self.writer = None
+        previous = bpy.path.abspath(s.cache_file) if s.cache_file else ""
+        os.replace(self.tmp_path, self.path)
+        self.tmp_path = None
+        if previous and os.path.normpath(previous) != self.path and os.path.isfile(previous):
+            try:
+                os.remove(previous)
+            except OSError:
+                pass
+
+    def hook_up(self, start_frame, frame_count, wetness, stuck, info):
+        """The Mesh Cache modifier, the attributes and the settings."""
+        ob, s = self.ob, self.settings
+        file_setting = self.path
+        if self.given_dir.startswith("//"):
+            file_setting = bpy.path.relpath(self.path)
+        mod = ob.modifiers.get(MODIFIER_NAME)
+        if mod is None or mod.type != "MESH_CACHE":
+            mod = ob.modifiers.new(MODIFIER_NAME, "MESH_CACHE")
+        mod.cache_format = "PC2"
+        mod.filepath = file_setting
+        mod.frame_start = float(start_frame)
+        mod.frame_scale = 1.0
+        mod.play_mode = "SCENE"
+        mod.time_mode = "FRAME"
+        mod.deform_mode = "OVERWRITE"
+        mod.interpolation = "LINEAR"
+        mod.forward_axis = "POS_Y"
+        mod.up_axis = "POS_Z"
+        mod.factor = 1.0
+        mod.show_viewport = True
+        mod.show_render = True
+
+        set_attribute(ob.data, WETNESS_ATTRIBUTE, wetness)
+        set_attribute(ob.data, STUCK_ATTRIBUTE, stuck)
+
+        s.cache_file = file_setting
+        s.baked_frames = frame_count
+        s.baked_start = start_frame
+        s.bake_info = info
+        ob.update_tag()
+
+    def drop_cache(self):
+        """Removes what this bake wrote for the object."""
+        if self.writer is not None:
+            try:
+                self.writer.file.close()
+            except OSError:
+                pass
+            self.writer = None
+        if self.tmp_path and os.path.exists(self.tmp_path):
+            try:
+                os.remove(self.tmp_path)
+            except OSError:
+                pass
+        self.tmp_path = None
+        self.restore_modifiers()
+
+
+class Baker:
+    """One bake of one or more objects in one world, where they collide with
+    each other (those with Collide with Cloths) and share the colliders:
+    start(), step() until done, then finish(); abort() at any point leaves
+    every object's previous bake as it was. The world's settings (frame
+    range, integrator, substeps) come from the first object, and the others
+    must agree with it."""
+
+    def __init__(self, context, objects):
+        self.scene = context.scene
+        self.view_layer = context.view_layer
+        if not isinstance(objects, (list, tuple)):
+            objects = [objects]
+        self.parts = [_ClothPart(ob) for ob in objects]
+        self.ob = objects[0]
+        self.settings = self.ob.wet_cloth
+        self.world = None
+        self.frame_before = self.scene.frame_current
+        self.done = False
+        self.info = ""
+        self.started = time.perf_counter()
+
+    @property
+    def objects(self):
+        return [p.ob for p in self.parts]
+
+    # setup ------------------------------------------------------------------
+
+    def _check_world_settings(self):
+        lead = _world_settings(self.settings, self.scene)
+        for p in self.parts[1:]:
+            for (name, want), (_n, got) in zip(lead, _world_settings(p.settings, self.scene)):
+                if got != want:
+                    raise BakeError("objects baked together share one world, so they need the "
+                                    "same %s: %s has %s, %s has %s" % (
+                                        name, self.ob.name, want, p.ob.name, got))
+
+    def _check_paths(self):
+        seen = {}
+        for p in self.parts:
+            other = seen.get(p.path)
+            if other is not None:
+                raise BakeError("%s and %s would write the same cache %s: rename one or give "
+                                "it another cache folder" % (other, p.ob.name, p.path))
+            seen[p.path] = p.ob.name
+
+    def _shared_colliders(self, cloth_objects):
+        """Every collider of any of the cloths, once, in the order found."""
+        found = []
+        for p in self.parts:
+            for o in p.find_colliders(self.scene, self.view_layer, cloth_objects):
+                if o not in found:
+                    found.append(o)
+        return found
+
+    def start(self):
+        scene = self.scene
+        for p in self.parts:
+            p.check(scene)
+        self._check_world_settings()
+        self._check_paths()
+        self.start_frame, self.end_frame = props.frame_range(self.settings, scene)
+        self.frame_count = self.end_frame - self.start_frame + 1
+        self.frame = self.start_frame
+        self.frame_dt = scene.render.fps_base / scene.render.fps
+        self.colliders = self._shared_colliders(self.objects)
+        for p in self.parts:
+            _check_folder(p.folder)
+
+        wetcloth = load_wetcloth()
+        self.wetcloth = wetcloth
+
+        # The cloth's own motion (pins) is read from the mesh as evaluated
+        # without this add-on's cache and what comes after it.
+        for p in self.parts:
+            p.hide_cache_modifiers()
+        scene.frame_set(self.start_frame)
+        depsgraph = self._depsgraph()
+        start_world = [p.world_positions(depsgraph) for p in self.parts]
+
+        gravity = tuple(scene.gravity) if scene.use_gravity else (0.0, 0.0, 0.0)
+        # alone, a cloth is baked as it always was (collide_with_cloths
+        # then changes nothing: a world of one cloth has no group)
+        together = len(self.parts) > 1
+        try:
+            self.world = wetcloth.World(gravity=gravity,
+                                        integrator=props.integrator_name(self.settings))
+            for p, positions in zip(self.parts, start_world):
+                p.add_to(self.world, wetcloth, positions,
+                         not together or p.settings.collide_with_cloths)
+            self.sim_colliders = []
+            for o in self.colliders:
+                v, t = _evaluated_mesh(o, depsgraph)
+                if t.shape[0] == 0:
+                    raise BakeError("collider %s has no faces" % o.name)
+                c = o.collision
+                self.sim_colliders.append(self.world.add_mesh_collider(
+                    v, t, thickness=float(c.thickness_outer),
+                    friction=min(10.0, float(c.cloth_friction) / 10.0)))
+        except wetcloth.WetclothError as e:
+            raise BakeError(str(e)) from None
+
+        for p, positions in zip(self.parts, start_world):
+            p.open_cache(wetcloth, self.frame_count, self.start_frame)
+            p.write_frame(positions, p.ob.matrix_world)
+        self.substeps = 0
+
+    def _depsgraph(self):
+        return bpy.context.evaluated_depsgraph_get()
 
     # stepping ---------------------------------------------------------------
 
@@ -348,17 +509,15 @@ class Baker:
                                     "%d): colliders must keep their topology" %
                                     (o.name, self.frame, v.shape[0], c.vertices.shape[0]))
                 c.set_vertices(v)
-            if self.pins.size:
-                targets = self._cloth_world_positions(depsgraph)[self.pins]
-                self.cloth.set_pin_targets(targets)
-            else:
-                self.matrix = _matrix(self.ob.evaluated_get(depsgraph).matrix_world)
+            for p in self.parts:
+                p.follow(depsgraph)
             substeps = 0 if self.settings.substeps_auto else self.settings.substeps
             self.substeps += self.world.advance(self.frame_dt, substeps)
-            positions = self.cloth.positions
+            positions = [p.cloth.positions for p in self.parts]
         except self.wetcloth.WetclothError as e:
             raise BakeError("frame %d: %s" % (self.frame, e)) from None
-        self._write_frame(positions, self.matrix)
+        for p, x in zip(self.parts, positions):
+            p.write_frame(x)
         if self.frame >= self.end_frame:
             self.done = True
 
@@ -369,74 +528,36 @@ class Baker:
     # ending -----------------------------------------------------------------
 
     def finish(self):
-        """Puts the new cache in place, then the modifier and attributes."""
-        ob, s = self.ob, self.settings
-        self.writer.close()
-        self.writer = None
-        previous = bpy.path.abspath(s.cache_file) if s.cache_file else ""
-        os.replace(self.tmp_path, self.path)
-        self.tmp_path = None
-        if previous and os.path.normpath(previous) != self.path and os.path.isfile(previous):
-            try:
-                os.remove(previous)
-            except OSError:
-                pass
-        wetness = self.cloth.wetness
-        stuck = self.cloth.stuck.astype(np.float64)
+        """Puts the new caches in place, then the modifiers and attributes."""
+        for p in self.parts:
+            p.take_cache()
+        state = [(p.cloth.wetness, p.cloth.stuck.astype(np.float64)) for p in self.parts]
         elapsed = time.perf_counter() - self.started
         frames = self.frame_count - 1
         self.world.close()
-        self._restore_modifiers()
-
-        file_setting = self.path
-        if self.given_dir.startswith("//"):
-            file_setting = bpy.path.relpath(self.path)
-        mod = ob.modifiers.get(MODIFIER_NAME)
-        if mod is None or mod.type != "MESH_CACHE":
-            mod = ob.modifiers.new(MODIFIER_NAME, "MESH_CACHE")
-        mod.cache_format = "PC2"
-        mod.filepath = file_setting
-        mod.frame_start = float(self.start_frame)
-        mod.frame_scale = 1.0
-        mod.play_mode = "SCENE"
-        mod.time_mode = "FRAME"
-        mod.deform_mode = "OVERWRITE"
-        mod.interpolation = "LINEAR"
-        mod.forward_axis = "POS_Y"
-        mod.up_axis = "POS_Z"
-        mod.factor = 1.0
-        mod.show_viewport = True
-        mod.show_render = True
-
-        set_attribute(ob.data, WETNESS_ATTRIBUTE, wetness)
-        set_attribute(ob.data, STUCK_ATTRIBUTE, stuck)
-
-        s.cache_file = file_setting
-        s.baked_frames = self.frame_count
-        s.baked_start = self.start_frame
-        s.bake_info = "%d frames in %.1f s, %.1f substeps per frame" % (
+        self.info = "%d frames in %.1f s, %.1f substeps per frame" % (
             self.frame_count, elapsed, self.substeps / max(1, frames))
+        for p, (wetness, stuck) in zip(self.parts, state):
+            p.restore_modifiers()
+            others = [o.name for o in self.objects if o is not p.ob]
+            p.hook_up(self.start_frame, self.frame_count, wetness, stuck,
+                      self.info + (", with " + ", ".join(others) if others else ""))
         self.scene.frame_set(self.frame_before)
-        ob.update_tag()
 
     def abort(self):
-        """Drops what this bake wrote; the previous bake stays."""
-        if self.writer is not None:
-            try:
-                self.writer.file.close()
-            except OSError:
-                pass
-            self.writer = None
-        if self.tmp_path and os.path.exists(self.tmp_path):
-            try:
-                os.remove(self.tmp_path)
-            except OSError:
-                pass
-        self.tmp_path = None
+        """Drops what this bake wrote; the previous bakes stay."""
+        for p in self.parts:
+            p.drop_cache()
         if self.world is not None:
             self.world.close()
-        self._restore_modifiers()
         self.scene.frame_set(self.frame_before)
+
+
+def bake_all_objects(context):
+    """The objects Bake All bakes: every mesh in the view layer with Wet
+    Cloth enabled, by name."""
+    return sorted((o for o in context.view_layer.objects
+                   if o.type == "MESH" and o.wet_cloth.enabled), key=lambda o: o.name)
 
 
 def set_attribute(mesh, name, values):

@@ -1,4 +1,5 @@
-"""Operators: wetcloth.bake and wetcloth.free_bake."""
+"""Operators: wetcloth.bake (the active object), wetcloth.bake_all (every Wet Cloth
+object together, in one world), wetcloth.free_bake and wetcloth.free_bake_all."""
 
 import time
 import traceback
@@ -8,7 +9,7 @@ from bpy.props import StringProperty
 
 from . import bake
 
-# Objects being baked interactively right now (one bake per object).
+# Objects being baked interactively right now (one bake at a time per object).
 _running = set()
 
 
@@ -32,31 +33,50 @@ def _failure_text(e):
     return "%s: %s (details on the console)" % (type(e).__name__, e)
 
 
-class WETCLOTH_OT_bake(bpy.types.Operator):
-    """Bake the wet cloth simulation of the object into a PC2 cache played back by a Mesh Cache
-modifier (Esc cancels and keeps the previous bake)"""
-    bl_idname = "wetcloth.bake"
-    bl_label = "Bake Wet Cloth"
-    bl_options = {"REGISTER"}
+def _names(objects):
+    return ", ".join(o.name for o in objects)
 
-    object: StringProperty(name="Object", default="", options={"SKIP_SAVE"},
-                           description="Object to bake (default: the active object)")
+
+class _BakeOperator:
+    """Bakes the objects of _objects() together in one world: synchronously
+    from scripts and headless Blender, in the background of the UI with a
+    progress bar (Esc cancels) when invoked there."""
 
     _timer = None
     _baker = None
 
+    def _objects(self, context):
+        raise NotImplementedError
+
+    def _prepare(self, context):
+        """A Baker for the objects, or None after reporting why not."""
+        try:
+            objects = self._objects(context)
+        except bake.BakeError as e:
+            self.report({"ERROR"}, str(e))
+            return None
+        busy = [o.name for o in objects if o.name in _running]
+        if busy:
+            self.report({"ERROR"}, "%s is being baked already" % ", ".join(busy))
+            return None
+        return bake.Baker(context, objects)
+
+    def _failed(self, baker, e):
+        baker.abort()
+        self.report({"ERROR"}, "Wet Cloth bake of %s failed: %s" % (_names(baker.objects),
+                                                                   _failure_text(e)))
+        return {"CANCELLED"}
+
+    def _baked(self, baker):
+        self.report({"INFO"}, "Wet Cloth: baked %s, %s" % (_names(baker.objects), baker.info))
+        return {"FINISHED"}
+
     # synchronous (scripts, headless Blender) --------------------------------
 
     def execute(self, context):
-        try:
-            ob = _target(self, context)
-        except bake.BakeError as e:
-            self.report({"ERROR"}, str(e))
+        baker = self._prepare(context)
+        if baker is None:
             return {"CANCELLED"}
-        if ob.name in _running:
-            self.report({"ERROR"}, "%s is being baked already" % ob.name)
-            return {"CANCELLED"}
-        baker = bake.Baker(context, ob)
         wm = context.window_manager
         progress = False
         try:
@@ -67,40 +87,27 @@ modifier (Esc cancels and keeps the previous bake)"""
                 baker.step()
                 wm.progress_update(baker.progress)
             baker.finish()
-        except Exception as e:  # reported to the user, previous bake kept
-            baker.abort()
-            self.report({"ERROR"}, "Wet Cloth bake of %s failed: %s" % (ob.name,
-                                                                       _failure_text(e)))
-            return {"CANCELLED"}
+        except Exception as e:  # reported to the user, previous bakes kept
+            return self._failed(baker, e)
         finally:
             if progress:
                 wm.progress_end()
-        self.report({"INFO"}, "Wet Cloth: baked %s, %s" % (ob.name, ob.wet_cloth.bake_info))
-        return {"FINISHED"}
+        return self._baked(baker)
 
     # interactive: modal, cancellable -----------------------------------------
 
     def invoke(self, context, event):
         if bpy.app.background or context.window is None:
             return self.execute(context)
-        try:
-            ob = _target(self, context)
-        except bake.BakeError as e:
-            self.report({"ERROR"}, str(e))
+        baker = self._prepare(context)
+        if baker is None:
             return {"CANCELLED"}
-        if ob.name in _running:
-            self.report({"ERROR"}, "%s is being baked already" % ob.name)
-            return {"CANCELLED"}
-        baker = bake.Baker(context, ob)
         try:
             baker.start()
         except Exception as e:
-            baker.abort()
-            self.report({"ERROR"}, "Wet Cloth bake of %s failed: %s" % (ob.name,
-                                                                       _failure_text(e)))
-            return {"CANCELLED"}
+            return self._failed(baker, e)
         self._baker = baker
-        _running.add(ob.name)
+        _running.update(o.name for o in baker.objects)
         wm = context.window_manager
         wm.progress_begin(0, baker.frame_count)
         self._timer = wm.event_timer_add(0.01, window=context.window)
@@ -111,7 +118,7 @@ modifier (Esc cancels and keeps the previous bake)"""
     def _status(self, context):
         b = self._baker
         text = "Wet Cloth: baking %s, frame %d of %d (Esc to cancel)" % (
-            b.ob.name, b.progress, b.frame_count)
+            _names(b.objects), b.progress, b.frame_count)
         if context.workspace is not None:
             context.workspace.status_text_set(text)
 
@@ -123,7 +130,7 @@ modifier (Esc cancels and keeps the previous bake)"""
         wm.progress_end()
         if context.workspace is not None:
             context.workspace.status_text_set(None)
-        _running.discard(self._baker.ob.name)
+        _running.difference_update(o.name for o in self._baker.objects)
 
     def modal(self, context, event):
         b = self._baker
@@ -131,7 +138,7 @@ modifier (Esc cancels and keeps the previous bake)"""
             b.abort()
             self._end(context)
             self.report({"WARNING"}, "Wet Cloth bake of %s cancelled; the previous bake is "
-                                     "kept" % b.ob.name)
+                                     "kept" % _names(b.objects))
             return {"CANCELLED"}
         if event.type != "TIMER":
             return {"PASS_THROUGH"}
@@ -142,18 +149,47 @@ modifier (Esc cancels and keeps the previous bake)"""
             if b.done:
                 b.finish()
                 self._end(context)
-                self.report({"INFO"}, "Wet Cloth: baked %s, %s" % (b.ob.name,
-                                                                   b.ob.wet_cloth.bake_info))
-                return {"FINISHED"}
+                return self._baked(b)
         except Exception as e:
-            b.abort()
             self._end(context)
-            self.report({"ERROR"}, "Wet Cloth bake of %s failed: %s" % (b.ob.name,
-                                                                       _failure_text(e)))
-            return {"CANCELLED"}
+            return self._failed(b, e)
         context.window_manager.progress_update(b.progress)
         self._status(context)
         return {"RUNNING_MODAL"}
+
+
+class WETCLOTH_OT_bake(_BakeOperator, bpy.types.Operator):
+    """Bake the wet cloth simulation of the object into a PC2 cache played back by a Mesh Cache
+modifier (Esc cancels and keeps the previous bake)"""
+    bl_idname = "wetcloth.bake"
+    bl_label = "Bake Wet Cloth"
+    bl_options = {"REGISTER"}
+
+    object: StringProperty(name="Object", default="", options={"SKIP_SAVE"},
+                           description="Object to bake (default: the active object)")
+
+    def _objects(self, context):
+        return [_target(self, context)]
+
+
+class WETCLOTH_OT_bake_all(_BakeOperator, bpy.types.Operator):
+    """Bake every Wet Cloth object of the view layer together, in one simulation, so that they
+collide with each other (and stick where wet); each gets its own cache (Esc cancels and keeps
+the previous bakes)"""
+    bl_idname = "wetcloth.bake_all"
+    bl_label = "Bake All Wet Cloth"
+    bl_options = {"REGISTER"}
+
+    def _objects(self, context):
+        objects = bake.bake_all_objects(context)
+        if not objects:
+            raise bake.BakeError("no mesh in the view layer has Wet Cloth enabled")
+        # the active object's world settings lead, when it is one of them
+        active = context.object
+        if active in objects:
+            objects.remove(active)
+            objects.insert(0, active)
+        return objects
 
 
 class WETCLOTH_OT_free_bake(bpy.types.Operator):
@@ -182,7 +218,34 @@ class WETCLOTH_OT_free_bake(bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (WETCLOTH_OT_bake, WETCLOTH_OT_free_bake)
+class WETCLOTH_OT_free_bake_all(bpy.types.Operator):
+    """Remove the baked caches, Mesh Cache modifiers and wetness attributes of every Wet Cloth
+object of the view layer"""
+    bl_idname = "wetcloth.free_bake_all"
+    bl_label = "Free All Wet Cloth Bakes"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        objects = bake.bake_all_objects(context)
+        busy = [o.name for o in objects if o.name in _running]
+        if busy:
+            self.report({"ERROR"}, "%s is being baked: cancel the bake first" % ", ".join(busy))
+            return {"CANCELLED"}
+        freed = []
+        try:
+            for ob in objects:
+                if bake.free_bake(ob):
+                    freed.append(ob.name)
+        except bake.BakeError as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        self.report({"INFO"}, "Wet Cloth: freed the bakes of %s" % ", ".join(freed) if freed
+                    else "Wet Cloth: no bake to free")
+        return {"FINISHED"}
+
+
+classes = (WETCLOTH_OT_bake, WETCLOTH_OT_bake_all, WETCLOTH_OT_free_bake,
+           WETCLOTH_OT_free_bake_all)
 
 
 def register():

@@ -139,6 +139,10 @@ class WetClothSettings(bpy.types.PropertyGroup):
                     "physics when empty)")
     self_collision: BoolProperty(name="Self Collisions", default=False,
                                  description="Collide the cloth with itself")
+    collide_with_cloths: BoolProperty(
+        name="Cloth Collisions", default=True,
+        description="When baked together with other Wet Cloth objects (Bake All): collide with "
+                    "those of them that do, and stick to them where wet")
 
     # Bake -----------------------------------------------------------------
     use_scene_range: BoolProperty(name="Scene Frame Range", default=True,

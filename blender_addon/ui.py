@@ -104,6 +104,7 @@ class PHYSICS_PT_wet_cloth_collisions(_WetClothSubPanel, bpy.types.Panel):
         sub.prop(s, "collision_collection", text="Collection")
         col.prop(s, "friction")
         col.prop(s, "self_collision")
+        col.prop(s, "collide_with_cloths")
 
 
 class PHYSICS_PT_wet_cloth_cache(_WetClothSubPanel, bpy.types.Panel):
@@ -136,6 +137,10 @@ class PHYSICS_PT_wet_cloth_cache(_WetClothSubPanel, bpy.types.Panel):
         row.use_property_split = False
         row.operator("wetcloth.bake", text="Bake", icon="PHYSICS")
         row.operator("wetcloth.free_bake", text="Free Bake", icon="TRASH")
+        row = layout.row(align=True)
+        row.use_property_split = False
+        row.operator("wetcloth.bake_all", text="Bake All", icon="PHYSICS")
+        row.operator("wetcloth.free_bake_all", text="Free All", icon="TRASH")
         if s.cache_file:
             box = layout.box()
             box.label(text="Baked: " + s.bake_info, icon="CHECKMARK")
