@@ -17,6 +17,7 @@ void wc_cloth_destroy(wc_cloth *c)
     double *arrays[] = {c->x,  c->y,  c->z,  c->px,      c->py,      c->pz,      c->nx,
                         c->ny, c->nz, c->fx, c->fy,      c->fz,      c->vx,      c->vy,
                         c->vz, c->mass, c->inv_mass, c->stretch_k, c->stretch_c, c->bend_r,
+                        c->bend_inv_rest, c->bend_coef,
                         c->link_fx, c->link_fy, c->link_fz, c->pins.from, c->pins.to,
                         c->normal_x, c->normal_y, c->normal_z, c->qx, c->qy, c->qz,
                         c->wetness, c->wetness_next};
@@ -58,6 +59,8 @@ static int alloc_particle_arrays(wc_cloth *c)
              alloc_doubles(&c->mass, n) & alloc_doubles(&c->inv_mass, n) &
              alloc_doubles(&c->stretch_k, (size_t)c->topology.stretch.count) &
              alloc_doubles(&c->bend_r, (size_t)c->topology.bend.count) &
+             alloc_doubles(&c->bend_inv_rest, (size_t)c->topology.bend.count) &
+             alloc_doubles(&c->bend_coef, (size_t)c->topology.bend.count) &
              alloc_doubles(&c->link_fx, links) & alloc_doubles(&c->link_fy, links) &
              alloc_doubles(&c->link_fz, links);
     if (needs_velocity)
@@ -227,6 +230,9 @@ void wc_cloth_apply_material(wc_cloth *c)
     for (int32_t e = 0; e < t->bend.count; ++e) {
         double soft = 1.0 - m->wet_softening * 0.5 * (w[t->bend.a[e]] + w[t->bend.b[e]]);
         c->bend_r[e] = m->bend_stiffness * t->bend.share[e] / t->bend.rest[e] * soft;
+        double inv_l = 1.0 / t->bend.rest[e];
+        c->bend_inv_rest[e] = inv_l;
+        c->bend_coef[e] = c->bend_r[e] * inv_l * inv_l;
     }
     c->stable_dt = estimate_stable_dt(c, mode_of(c->integrator));
     c->wet_forces = any_wet_force(c);

@@ -50,6 +50,10 @@ typedef struct wc_cloth {
     double *stretch_c;
     /// Buckling constant R per bend link, N m^2.
     double *bend_r;
+    /// Per bend link, what its force needs every step (forces.c), derived
+    /// with R: 1 / l, 1/m, and R / l^2, N, computed as (R * (1 / l)) * (1 / l),
+    /// the rounding the force loop had when it computed them itself.
+    double *bend_inv_rest, *bend_coef;
     /// Force on the lower-index end of each link, N: stretch links first,
     /// then bend links. Written once per link, then gathered per particle.
     double *link_fx, *link_fy, *link_fz;

@@ -106,6 +106,18 @@ static double buckling_slope(double d, double l, double R)
     return slope > 0.0 ? R / (l * l * l) * slope : 0.0;
 }
 
+/* What the loops of one step need, each a part of it: the loops run
+ * through wc_parallel_for (parallel.h), which passes one pointer. */
+typedef struct implicit_pass {
+    const wc_cloth *cloth;
+    wc_implicit_state *state;
+    double h, pin_fraction;
+    /* dot: a . b; apply, precondition: out = M in; updates: the factor */
+    const double *a, *b, *in;
+    double *out;
+    double factor;
+} implicit_pass;
+
 static void set_block(double *b, double along, double across, double ux, double uy, double uz)
 {
     /* along u u^T + across I */
@@ -128,14 +140,16 @@ static void block_times(const double *b, double x, double y, double z, double ou
  *     the ends apart, so that term is negative and would make M - h^2 df/dx
  *     indefinite (Choi & Ko 2002, section 4.2);
  *   stretch dashpots: C = c u u^T, taut or slack, as in forces.c. */
-static void link_blocks(const wc_cloth *c, wc_implicit_state *s, double h, int threads)
+static int link_blocks_range(void *context, int64_t begin, int64_t end)
 {
-    (void)threads;
+    const implicit_pass *pass = context;
+    const wc_cloth *c = pass->cloth;
+    wc_implicit_state *s = pass->state;
+    double h = pass->h;
     const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
-    int32_t ns = st->count, links = s->links;
+    int32_t ns = st->count;
     const double *v0 = s->v0;
-#pragma omp parallel for schedule(static) num_threads(threads) if (links >= WC_PARALLEL_MIN)
-    for (int32_t e = 0; e < links; ++e) {
+    for (int64_t e = begin; e < end; ++e) {
         int32_t a = s->end_a[e], b = s->end_b[e];
         double dx = c->x[a] - c->x[b], dy = c->y[a] - c->y[b], dz = c->z[a] - c->z[b];
         double d = sqrt(dx * dx + dy * dy + dz * dz);
@@ -147,7 +161,7 @@ static void link_blocks(const wc_cloth *c, wc_implicit_state *s, double h, int t
             if (d > l) along = k * l / d, across = k * (1.0 - l / d);
             if (c->stretch_c && d > 0.0) damp = c->stretch_c[e];
         } else {
-            int32_t f = e - ns;
+            int32_t f = (int32_t)e - ns;
             along = buckling_slope(d, bd->rest[f], c->bend_r[f]);
             if (!(d > 0.0)) along = 0.0;
         }
@@ -157,19 +171,20 @@ static void link_blocks(const wc_cloth *c, wc_implicit_state *s, double h, int t
                     v0[3 * a + 2] - v0[3 * b + 2], kv);
         set_block(blk, h * h * along + h * damp, h * h * across, ux, uy, uz);
     }
+    return 0;
 }
 
 /* Start velocity (as forces.c computes it) and, for pins, the known change
  * of velocity that takes them to their targets. */
-static void start_velocities(const wc_cloth *c, wc_implicit_state *s, double h,
-                             double pin_fraction, int threads)
+static int start_velocities_range(void *context, int64_t begin, int64_t end)
 {
-    (void)threads;
-    int32_t n = c->particle_count;
+    const implicit_pass *pass = context;
+    const wc_cloth *c = pass->cloth;
+    wc_implicit_state *s = pass->state;
+    double h = pass->h, pin_fraction = pass->pin_fraction;
     int first = !c->has_history;
     double inv_prev = first ? 0.0 : 1.0 / c->dt_prev;
-#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
-    for (int32_t i = 0; i < n; ++i) {
+    for (int64_t i = begin; i < end; ++i) {
         double *v = s->v0 + 3 * (size_t)i, *fx = s->fixed + 3 * (size_t)i;
         if (first) {
             v[0] = c->px[i], v[1] = c->py[i], v[2] = c->pz[i];
@@ -187,6 +202,7 @@ static void start_velocities(const wc_cloth *c, wc_implicit_state *s, double h,
             fx[2] = (p[2] - c->z[i]) / h - v[2];
         }
     }
+    return 0;
 }
 
 /* Inverse of a symmetric 3 x 3 block (xx, xy, xz, yy, yz, zz); the block
@@ -208,14 +224,13 @@ static void invert_block(const double *m, double *out)
  * right-hand side h f_i + h^2 (df/dx v0)_i plus what the pins' known dv
  * contribute, and the preconditioner (the inverse diagonal block). Pinned
  * rows are zero: their dv is known, not solved for. */
-static void rhs_and_preconditioner(const wc_cloth *c, wc_implicit_state *s, double h,
-                                   int threads)
+static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t end)
 {
-    (void)threads;
-    int32_t n = c->particle_count;
-    double drag = c->material.air_drag, h2 = h * h;
-#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
-    for (int32_t i = 0; i < n; ++i) {
+    const implicit_pass *pass = context;
+    const wc_cloth *c = pass->cloth;
+    wc_implicit_state *s = pass->state;
+    double h = pass->h, drag = c->material.air_drag, h2 = h * h;
+    for (int64_t i = begin; i < end; ++i) {
         double *b = s->rhs + 3 * (size_t)i, *pre = s->precond + 6 * (size_t)i;
         if (c->pin_slot[i] >= 0) {
             b[0] = b[1] = b[2] = 0.0;
@@ -243,17 +258,19 @@ static void rhs_and_preconditioner(const wc_cloth *c, wc_implicit_state *s, doub
         b[0] = bx, b[1] = by, b[2] = bz;
         invert_block(diag, pre);
     }
+    return 0;
 }
 
 /* out = A in, A = M + h drag A_i + sum_links B (in_i - in_j), over free
  * particles; in is zero at pins and so is out. */
-static void apply(const wc_cloth *c, const wc_implicit_state *s, const double *in, double *out,
-                  int threads)
+static int apply_range(void *context, int64_t begin, int64_t end)
 {
-    (void)threads;
-    int32_t n = c->particle_count;
-#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
-    for (int32_t i = 0; i < n; ++i) {
+    const implicit_pass *pass = context;
+    const wc_cloth *c = pass->cloth;
+    const wc_implicit_state *s = pass->state;
+    const double *in = pass->in;
+    double *out = pass->out;
+    for (int64_t i = begin; i < end; ++i) {
         double *o = out + 3 * (size_t)i;
         if (c->pin_slot[i] >= 0) {
             o[0] = o[1] = o[2] = 0.0;
@@ -271,82 +288,111 @@ static void apply(const wc_cloth *c, const wc_implicit_state *s, const double *i
         }
         o[0] = ox, o[1] = oy, o[2] = oz;
     }
+    return 0;
 }
 
-static void precondition(const wc_implicit_state *s, const double *in, double *out, int threads)
+static int precondition_range(void *context, int64_t begin, int64_t end)
 {
-    (void)threads;
-    int32_t n = s->n;
-#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
-    for (int32_t i = 0; i < n; ++i)
-        block_times(s->precond + 6 * (size_t)i, in[3 * (size_t)i], in[3 * (size_t)i + 1],
+    const implicit_pass *pass = context;
+    const double *in = pass->in, *precond = pass->state->precond;
+    double *out = pass->out;
+    for (int64_t i = begin; i < end; ++i)
+        block_times(precond + 6 * (size_t)i, in[3 * (size_t)i], in[3 * (size_t)i + 1],
                     in[3 * (size_t)i + 2], out + 3 * (size_t)i);
+    return 0;
+}
+
+/* out = A in (apply_range) or out = P in (precondition_range) over the
+ * particles. */
+static void particle_pass(implicit_pass *pass, wc_range_fn body, const double *in, double *out,
+                          int threads)
+{
+    int32_t n = pass->state->n;
+    pass->in = in, pass->out = out;
+    wc_parallel_for(n, wc_threads_for(n, threads), body, pass);
 }
 
 /* a . b over 3n values, summed in fixed chunks, then the chunks in order. */
-static double dot(const wc_implicit_state *s, const double *a, const double *b, int threads)
+static int dot_range(void *context, int64_t first, int64_t last)
 {
-    (void)threads;
-    int64_t len = 3 * (int64_t)s->n;
-    int32_t chunks = s->chunks;
-    double *partial = s->partial;
-#pragma omp parallel for schedule(static) num_threads(threads) if (s->n >= WC_PARALLEL_MIN)
-    for (int32_t k = 0; k < chunks; ++k) {
-        int64_t begin = (int64_t)k * CHUNK, end = begin + CHUNK < len ? begin + CHUNK : len;
+    const implicit_pass *pass = context;
+    const double *a = pass->a, *b = pass->b;
+    int64_t len = 3 * (int64_t)pass->state->n;
+    for (int64_t k = first; k < last; ++k) {
+        int64_t begin = k * CHUNK, end = begin + CHUNK < len ? begin + CHUNK : len;
         double sum = 0.0;
         for (int64_t i = begin; i < end; ++i) sum += a[i] * b[i];
-        partial[k] = sum;
+        pass->state->partial[k] = sum;
     }
+    return 0;
+}
+
+static double dot(implicit_pass *pass, const double *a, const double *b, int threads)
+{
+    const wc_implicit_state *s = pass->state;
+    pass->a = a, pass->b = b;
+    wc_parallel_for(s->chunks, wc_threads_for(s->n, threads), dot_range, pass);
     double total = 0.0;
-    for (int32_t k = 0; k < chunks; ++k) total += partial[k];
+    for (int32_t k = 0; k < s->chunks; ++k) total += s->partial[k];
     return total;
 }
 
 /* y += alpha p; r -= alpha q. */
-static void update_solution(wc_implicit_state *s, double alpha, int threads)
+static int update_solution_range(void *context, int64_t begin, int64_t end)
 {
-    (void)threads;
-    int64_t len = 3 * (int64_t)s->n;
-#pragma omp parallel for schedule(static) num_threads(threads) if (s->n >= WC_PARALLEL_MIN)
-    for (int64_t i = 0; i < len; ++i) {
+    const implicit_pass *pass = context;
+    wc_implicit_state *s = pass->state;
+    double alpha = pass->factor;
+    for (int64_t i = begin; i < end; ++i) {
         s->y[i] += alpha * s->p[i];
         s->r[i] -= alpha * s->q[i];
     }
+    return 0;
 }
 
 /* p = z + beta p. */
-static void update_direction(wc_implicit_state *s, double beta, int threads)
+static int update_direction_range(void *context, int64_t begin, int64_t end)
 {
-    (void)threads;
-    int64_t len = 3 * (int64_t)s->n;
-#pragma omp parallel for schedule(static) num_threads(threads) if (s->n >= WC_PARALLEL_MIN)
-    for (int64_t i = 0; i < len; ++i) s->p[i] = s->z[i] + beta * s->p[i];
+    const implicit_pass *pass = context;
+    wc_implicit_state *s = pass->state;
+    double beta = pass->factor;
+    for (int64_t i = begin; i < end; ++i) s->p[i] = s->z[i] + beta * s->p[i];
+    return 0;
+}
+
+/* One of the two updates over the 3n values with the given factor. */
+static void vector_update(implicit_pass *pass, wc_range_fn body, double factor, int threads)
+{
+    int32_t n = pass->state->n;
+    pass->factor = factor;
+    wc_parallel_for(3 * (int64_t)n, wc_threads_for(n, threads), body, pass);
 }
 
 /* Preconditioned conjugate gradients on A y = rhs from y = 0. */
-static void solve(const wc_cloth *c, wc_implicit_state *s, int threads)
+static void solve(implicit_pass *pass, int threads)
 {
+    wc_implicit_state *s = pass->state;
     size_t bytes = 3 * (size_t)s->n * sizeof(double);
     memset(s->y, 0, bytes);
     memcpy(s->r, s->rhs, bytes);
-    double bb = dot(s, s->rhs, s->rhs, threads), rr = bb;
+    double bb = dot(pass, s->rhs, s->rhs, threads), rr = bb;
     int32_t it = 0;
     if (bb > 0.0) {
-        precondition(s, s->r, s->z, threads);
+        particle_pass(pass, precondition_range, s->r, s->z, threads);
         memcpy(s->p, s->z, bytes);
-        double rz = dot(s, s->r, s->z, threads);
+        double rz = dot(pass, s->r, s->z, threads);
         for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
-            apply(c, s, s->p, s->q, threads);
-            double pq = dot(s, s->p, s->q, threads);
+            particle_pass(pass, apply_range, s->p, s->q, threads);
+            double pq = dot(pass, s->p, s->q, threads);
             /* A is positive definite, so pq > 0 unless p = 0 or something
              * is not finite: then stop, the caller checks the result */
             if (!(pq > 0.0) || !isfinite(pq)) break;
             double alpha = rz / pq;
-            update_solution(s, alpha, threads);
-            rr = dot(s, s->r, s->r, threads);
-            precondition(s, s->r, s->z, threads);
-            double rz_next = dot(s, s->r, s->z, threads);
-            update_direction(s, rz_next / rz, threads);
+            vector_update(pass, update_solution_range, alpha, threads);
+            rr = dot(pass, s->r, s->r, threads);
+            particle_pass(pass, precondition_range, s->r, s->z, threads);
+            double rz_next = dot(pass, s->r, s->z, threads);
+            vector_update(pass, update_direction_range, rz_next / rz, threads);
             rz = rz_next;
         }
     }
@@ -367,22 +413,23 @@ static int32_t first_non_finite_rhs(const wc_implicit_state *s)
     return -1;
 }
 
-int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, int threads)
+/* v1 = v0 + dv, x1 = x + h v1; pins exactly at their targets. */
+typedef struct positions_pass {
+    wc_cloth *cloth;
+    const wc_implicit_state *state;
+    double dt, pin_fraction;
+} positions_pass;
+
+static int positions_range(void *context, int64_t begin, int64_t end)
 {
-    wc_implicit_state *s = c->implicit;
-    int32_t n = c->particle_count;
-    start_velocities(c, s, dt, pin_fraction, threads);
-    link_blocks(c, s, dt, threads);
-    rhs_and_preconditioner(c, s, dt, threads);
-    int32_t bad = first_non_finite_rhs(s);
-    if (bad >= 0) return bad;
-    solve(c, s, threads);
-    /* v1 = v0 + dv, x1 = x + h v1; pins exactly at their targets */
-#pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
-    for (int32_t i = 0; i < n; ++i) {
+    const positions_pass *pass = context;
+    wc_cloth *c = pass->cloth;
+    const wc_implicit_state *s = pass->state;
+    double dt = pass->dt;
+    for (int64_t i = begin; i < end; ++i) {
         if (c->pin_slot[i] >= 0) {
             double p[3];
-            wc_pinned_position(c, c->pin_slot[i], pin_fraction, p);
+            wc_pinned_position(c, c->pin_slot[i], pass->pin_fraction, p);
             c->nx[i] = p[0], c->ny[i] = p[1], c->nz[i] = p[2];
             continue;
         }
@@ -391,5 +438,22 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, int t
         c->ny[i] = c->y[i] + dt * (v[1] + y[1]);
         c->nz[i] = c->z[i] + dt * (v[2] + y[2]);
     }
+    return 0;
+}
+
+int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, int threads)
+{
+    wc_implicit_state *s = c->implicit;
+    int32_t n = c->particle_count;
+    int particle_threads = wc_threads_for(n, threads);
+    implicit_pass pass = {c, s, dt, pin_fraction, NULL, NULL, NULL, NULL, 0.0};
+    wc_parallel_for(n, particle_threads, start_velocities_range, &pass);
+    wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
+    wc_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);
+    int32_t bad = first_non_finite_rhs(s);
+    if (bad >= 0) return bad;
+    solve(&pass, threads);
+    positions_pass positions = {c, s, dt, pin_fraction};
+    wc_parallel_for(n, particle_threads, positions_range, &positions);
     return wc_first_non_finite_xyz(c->nx, c->ny, c->nz, n);
 }

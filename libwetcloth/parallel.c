@@ -13,3 +13,23 @@ int wc_thread_count(int requested)
     return 1;
 #endif
 }
+
+int wc_parallel_for(int64_t n, int threads, wc_range_fn body, void *context)
+{
+    if (n <= 0) return 0;
+#ifdef _OPENMP
+    if (threads > 1) {
+        int flagged = 0;
+#pragma omp parallel num_threads(threads) reduction(|| : flagged)
+        {
+            int64_t t = omp_get_thread_num(), nt = omp_get_num_threads();
+            int64_t begin = n * t / nt, end = n * (t + 1) / nt;
+            if (begin < end) flagged = body(context, begin, end) != 0;
+        }
+        return flagged;
+    }
+#else
+    (void)threads;
+#endif
+    return body(context, 0, n) != 0;
+}

@@ -153,21 +153,33 @@ static void project_link(wc_cloth *c, double *lambda, int32_t e, double h, int s
     c->nx[b] -= wb * dl * ux, c->ny[b] -= wb * dl * uy, c->nz[b] -= wb * dl * uz;
 }
 
+/* Projections of a run of links of one colour. */
+typedef struct sweep_pass {
+    wc_cloth *cloth;
+    double *lambda;
+    const int32_t *links;
+    double h;
+    int slack;
+} sweep_pass;
+
+static int sweep_range(void *context, int64_t begin, int64_t end)
+{
+    const sweep_pass *p = context;
+    for (int64_t i = begin; i < end; ++i) project_link(p->cloth, p->lambda, p->links[i], p->h, p->slack);
+    return 0;
+}
+
 /* One Gauss-Seidel sweep over the stretch links, colour by colour: their
  * dashpots where slack (slack = 1), or their constraints (slack = 0). */
 static void sweep(wc_cloth *c, link_colors *lc, double h, int slack, int threads)
 {
-    (void)threads;
     for (int32_t k = 0; k < lc->color_count; ++k) {
-        int32_t begin = lc->color_start[k], end = lc->color_start[k + 1];
-        if (lc->serial_last && k == lc->color_count - 1) {
-            for (int32_t i = begin; i < end; ++i) project_link(c, lc->lambda, lc->links[i], h, slack);
-            continue;
-        }
+        int32_t begin = lc->color_start[k], count = lc->color_start[k + 1] - begin;
+        sweep_pass pass = {c, lc->lambda, lc->links + begin, h, slack};
         /* links of one colour share no particle: any thread order gives the
-         * same bits */
-#pragma omp parallel for schedule(static) num_threads(threads) if (end - begin >= WC_PARALLEL_MIN)
-        for (int32_t i = begin; i < end; ++i) project_link(c, lc->lambda, lc->links[i], h, slack);
+         * same bits; the serial remainder's do */
+        int serial = lc->serial_last && k == lc->color_count - 1;
+        wc_parallel_for(count, serial ? 1 : wc_threads_for(count, threads), sweep_range, &pass);
     }
 }
 
