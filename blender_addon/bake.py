@@ -90,10 +90,40 @@ def _positions(mesh):
     return co.reshape(-1, 3).astype(np.float64)
 
 
+def loop_triangles(mesh):
+    """((T, 3) vertex indices, (T,) polygon indices) of Blender's
+    triangulation of the mesh, in an order set by the vertices alone.
+
+    The order of the triangles is part of the library's input (its sums run
+    in it), but not part of a shape: Blender's own order follows the order of
+    the polygons and loops, which edits can change without moving a vertex,
+    and which bpy 4.5's primitive operators (UV sphere) make differently in
+    each process. Each triangle starts at its lowest vertex index (which keeps
+    its winding), and the triangles are sorted by their vertices."""
+    mesh.calc_loop_triangles()
+    n = len(mesh.loop_triangles)
+    tri = np.empty(3 * n, dtype=np.int32)
+    poly = np.empty(n, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tri)
+    mesh.loop_triangles.foreach_get("polygon_index", poly)
+    tri = _lowest_first(tri.reshape(-1, 3))
+    order = np.lexsort(tri.T[::-1])
+    return tri[order], poly[order]
+
+
+def _lowest_first(faces):
+    """(F, k) faces, each turned to start at its lowest vertex index (the
+    winding stays)."""
+    k = faces.shape[1]
+    first = np.argmin(faces, axis=1)
+    return faces[np.arange(faces.shape[0])[:, None], (first[:, None] + np.arange(k)[None, :]) % k]
+
+
 def cloth_faces(mesh):
     """(F, 4) faces for the library: triangles and quads as they are
     (a last index of -1 makes a triangle), other polygons as Blender
-    triangulates them."""
+    triangulates them. The polygons' own order and first corners stay:
+    the library splits a quad from its first corner, as the mesh has it."""
     sizes = np.empty(len(mesh.polygons), dtype=np.int32)
     starts = np.empty(len(mesh.polygons), dtype=np.int32)
     mesh.polygons.foreach_get("loop_total", sizes)
@@ -109,12 +139,8 @@ def cloth_faces(mesh):
                 idx = np.concatenate([idx, np.full((idx.shape[0], 1), -1, np.int32)], axis=1)
             faces.append(idx)
     if np.any(sizes > 4):
-        mesh.calc_loop_triangles()
-        tri = np.empty(3 * len(mesh.loop_triangles), dtype=np.int32)
-        poly = np.empty(len(mesh.loop_triangles), dtype=np.int32)
-        mesh.loop_triangles.foreach_get("vertices", tri)
-        mesh.loop_triangles.foreach_get("polygon_index", poly)
-        tri = tri.reshape(-1, 3)[sizes[poly] > 4]
+        tri, poly = loop_triangles(mesh)
+        tri = tri[sizes[poly] > 4]
         faces.append(np.concatenate([tri, np.full((tri.shape[0], 1), -1, np.int32)], axis=1))
     if not faces:
         return np.zeros((0, 4), dtype=np.int32)
@@ -155,14 +181,12 @@ def _evaluated_mesh(ob, depsgraph, matrix=None):
     ev = ob.evaluated_get(depsgraph)
     mesh = ev.to_mesh()
     try:
-        mesh.calc_loop_triangles()
         v = _positions(mesh)
-        t = np.empty(3 * len(mesh.loop_triangles), dtype=np.int32)
-        mesh.loop_triangles.foreach_get("vertices", t)
+        t, _poly = loop_triangles(mesh)
         m = _matrix(ev.matrix_world if matrix is None else matrix)
     finally:
         ev.to_mesh_clear()
-    return _to_world(v, m), t.reshape(-1, 3)
+    return _to_world(v, m), t
 
 
 # ---------------------------------------------------------------------------
