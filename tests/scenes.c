@@ -43,17 +43,32 @@ int32_t scene_uv_sphere(double r, int32_t seg, int32_t rings, double *v, int32_t
     return n;
 }
 
+wc_world *scene_world_from(const wc_world_def *def)
+{
+    wc_world *w = NULL;
+    wc_message msg;
+    if (wc_world_create(def, &w, &msg) != WC_OK) {
+        fprintf(stderr, "wc_world_create: %s\n", msg.text);
+        exit(1);
+    }
+    return w;
+}
+
 wc_world *scene_world(int32_t threads)
 {
     wc_world_def def = wc_world_def_default();
     def.thread_count = threads;
-    wc_world *w = NULL;
-    wc_message msg;
-    if (wc_world_create(&def, &w, &msg) != WC_OK) {
-        fprintf(stderr, "scene_world: %s\n", msg.text);
+    return scene_world_from(&def);
+}
+
+int32_t scene_add_grid(wc_world *w, const wc_grid_cloth_def *def)
+{
+    int32_t id = -1;
+    if (wc_world_add_grid_cloth(w, def, &id) != WC_OK) {
+        fprintf(stderr, "wc_world_add_grid_cloth: %s\n", wc_world_last_error(w));
         exit(1);
     }
-    return w;
+    return id;
 }
 
 int32_t scene_add_thesis_sphere(wc_world *w, double radius)

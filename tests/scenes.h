@@ -13,9 +13,15 @@
 int32_t scene_uv_sphere(double radius, int32_t segments, int32_t rings, double *vertices,
                         int32_t *triangles, int32_t *triangle_count);
 
+/// Creates a world from `def`; aborts the test on failure.
+wc_world *scene_world_from(const wc_world_def *def);
+
 /// Creates a world with default settings and the given thread count; aborts
 /// the test on failure.
 wc_world *scene_world(int32_t threads);
+
+/// Adds a grid cloth; aborts the test on failure. Returns its index.
+int32_t scene_add_grid(wc_world *world, const wc_grid_cloth_def *def);
 
 /// Adds the thesis' 114-vertex UV sphere (radius r, centre at the origin) as
 /// a mesh collider; returns its index.

@@ -49,23 +49,7 @@ static wc_world *make_world(wc_integrator integrator, int32_t threads, double gz
     def.thread_count = threads;
     def.integrator = integrator;
     def.gravity[2] = gz;
-    wc_world *w = NULL;
-    wc_message msg;
-    if (wc_world_create(&def, &w, &msg) != WC_OK) {
-        fprintf(stderr, "wc_world_create: %s\n", msg.text);
-        exit(1);
-    }
-    return w;
-}
-
-static int32_t add_grid(wc_world *w, const wc_grid_cloth_def *g)
-{
-    int32_t id = -1;
-    if (wc_world_add_grid_cloth(w, g, &id) != WC_OK) {
-        fprintf(stderr, "add_grid_cloth: %s\n", wc_world_last_error(w));
-        exit(1);
-    }
-    return id;
+    return scene_world_from(&def);
 }
 
 static double *get_positions(const wc_world *w, int32_t cloth)
@@ -214,7 +198,7 @@ static uint64_t case_auto_substeps(int32_t threads, int report)
     for (int which = 0; which < 3; ++which) {
         wc_world *w = make_world((wc_integrator)which, threads, -9.81);
         wc_grid_cloth_def g = grid(n, 0.0, wc_material_default(), 0);
-        int32_t c = add_grid(w, &g);
+        int32_t c = scene_add_grid(w, &g);
         int32_t pins[2] = {n * (n - 1), n * n - 1};
         CHECK(wc_cloth_pin(w, c, pins, 2) == WC_OK, "pin");
         double e0 = world_energy(w), scale = cloth_mass(w, c) * 9.81 * 1.0, worst = -INFINITY;
@@ -264,7 +248,7 @@ static uint64_t case_forced_steps(int32_t threads, int report)
     for (size_t k = 0; k < sizeof factor / sizeof factor[0]; ++k) {
         wc_world *w = make_world(WC_INTEGRATOR_VERLET, threads, -9.81);
         wc_grid_cloth_def g = grid(n, 0.0, wc_material_default(), 0);
-        int32_t c = add_grid(w, &g);
+        int32_t c = scene_add_grid(w, &g);
         int32_t pins[2] = {n * (n - 1), n * n - 1};
         CHECK(wc_cloth_pin(w, c, pins, 2) == WC_OK, "pin");
         double dt = fmin(10.0, factor[k] * wc_world_stable_dt(w));
@@ -327,7 +311,7 @@ static uint64_t case_very_stiff(int32_t threads, int report)
         m.stretch_stiffness = 1e8;
         m.bend_stiffness = 1e-2;
         wc_grid_cloth_def g = grid(n, 0.0, m, 0);
-        int32_t c = add_grid(w, &g);
+        int32_t c = scene_add_grid(w, &g);
         int32_t pins[2] = {n * (n - 1), n * n - 1};
         CHECK(wc_cloth_pin(w, c, pins, 2) == WC_OK, "pin");
         double e0 = world_energy(w), scale = cloth_mass(w, c) * 9.81, worst = -INFINITY;
@@ -369,7 +353,7 @@ static uint64_t case_stretched_10x(int32_t threads, int report)
     for (int which = 0; which < 3; ++which) {
         wc_world *w = make_world((wc_integrator)which, threads, 0.0);
         wc_grid_cloth_def g = grid(n, 0.0, wc_material_default(), 0);
-        int32_t c = add_grid(w, &g);
+        int32_t c = scene_add_grid(w, &g);
         double *p = get_positions(w, c);
         for (int32_t i = 0; i < 3 * n * n; ++i) p[i] *= 10.0;
         CHECK(wc_cloth_set_positions(w, c, p, n * n) == WC_OK, "set_positions");
@@ -424,7 +408,7 @@ static uint64_t case_folded(int32_t threads, int report)
             wc_material m = wc_material_default();
             m.bend_stiffness = 1e-3;
             wc_grid_cloth_def g = grid(n, 0.0, m, 0);
-            int32_t c = add_grid(w, &g);
+            int32_t c = scene_add_grid(w, &g);
             double *p = get_positions(w, c);
             for (int32_t j = 0; j < n; ++j)
                 for (int32_t i = 0; i < n; ++i) {
@@ -475,7 +459,7 @@ static uint64_t case_fast_plate(int32_t threads, int report)
     const int32_t n = SANITIZED ? 12 : 20;
     wc_world *w = make_world(WC_INTEGRATOR_VERLET, threads, -9.81);
     wc_grid_cloth_def g = grid(n, 0.0, wc_material_default(), 0);
-    int32_t c = add_grid(w, &g);
+    int32_t c = scene_add_grid(w, &g);
     (void)c;
     const double u[3] = {1, 0, 0}, v[3] = {0, 1, 0};
     double centre[3] = {0.013, -0.021, -0.3}, xyz[12];
@@ -523,7 +507,7 @@ static uint64_t case_crumple(int32_t threads, int report)
     const int32_t n = SANITIZED ? 12 : 20;
     wc_world *w = make_world(WC_INTEGRATOR_VERLET, threads, -9.81);
     wc_grid_cloth_def g = grid(n, 0.05, wc_material_default(), 1);
-    int32_t c = add_grid(w, &g);
+    int32_t c = scene_add_grid(w, &g);
     const double u[3] = {1, 0, 0}, v[3] = {0, 1, 0}, floor_at[3] = {0, 0, 0};
     scene_add_plate(w, floor_at, u, v, 3.0, 0.0);
     int32_t pins[4] = {0, n - 1, n * (n - 1), n * n - 1};
@@ -587,7 +571,7 @@ static uint64_t case_heavy_load(int32_t threads, int report)
         wc_material m = wc_material_default();
         m.density = 1000.0;
         wc_grid_cloth_def g = grid(n, 0.0, m, 0);
-        int32_t c = add_grid(w, &g);
+        int32_t c = scene_add_grid(w, &g);
         int32_t pins[4] = {0, n - 1, n * (n - 1), n * n - 1};
         CHECK(wc_cloth_pin(w, c, pins, 4) == WC_OK, "pin");
         double e0 = world_energy(w), scale = cloth_mass(w, c) * 9.81, worst = -INFINITY;

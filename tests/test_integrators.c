@@ -45,23 +45,7 @@ static wc_world *make_world(wc_integrator integrator, const double g[3], int32_t
     for (int k = 0; k < 3; ++k) def.gravity[k] = g[k];
     def.thread_count = threads;
     def.integrator = integrator;
-    wc_world *w = NULL;
-    wc_message msg;
-    if (wc_world_create(&def, &w, &msg) != WC_OK) {
-        fprintf(stderr, "wc_world_create: %s\n", msg.text);
-        exit(1);
-    }
-    return w;
-}
-
-static int32_t add_grid(wc_world *w, const wc_grid_cloth_def *g)
-{
-    int32_t id = -1;
-    if (wc_world_add_grid_cloth(w, g, &id) != WC_OK) {
-        fprintf(stderr, "add_grid_cloth: %s\n", wc_world_last_error(w));
-        exit(1);
-    }
-    return id;
+    return scene_world_from(&def);
 }
 
 static int all_finite(const double *p, int32_t count)
@@ -100,7 +84,7 @@ static void free_fall(int which)
     def.axis_u[0] = cos(0.4), def.axis_u[1] = 0.0, def.axis_u[2] = sin(0.4);
     def.material.stretch_damping = 0.0;
     def.material.air_drag = 0.0;
-    int32_t id = add_grid(w, &def);
+    int32_t id = scene_add_grid(w, &def);
     int32_t n = wc_cloth_particle_count(w, id);
     double *x0 = malloc(3 * (size_t)n * sizeof *x0), *x = malloc(3 * (size_t)n * sizeof *x);
     double *v = malloc(3 * (size_t)n * sizeof *v);
@@ -166,7 +150,7 @@ static double hang(wc_integrator integrator, int32_t substeps, double *out)
     def.axis_v[0] = 0.0, def.axis_v[1] = 0.0, def.axis_v[2] = 1.0;
     def.material.stretch_damping = 0.5;
     def.material.air_drag = 2.0;
-    int32_t id = add_grid(w, &def);
+    int32_t id = scene_add_grid(w, &def);
     int32_t pins[2] = {HANG_N * (HANG_N - 1), HANG_N * HANG_N - 1};
     wc_cloth_pin(w, id, pins, 2);
     int frames = (int)(HANG_SECONDS * 24);
@@ -202,7 +186,7 @@ static void hanging(void)
     def.count_u = def.count_v = HANG_N;
     def.material.stretch_damping = 0.5;
     def.material.air_drag = 2.0;
-    add_grid(probe, &def);
+    scene_add_grid(probe, &def);
     int32_t fine = (int32_t)ceil(1.0 / 24 / wc_world_stable_dt(probe)) * 10;
     wc_world_destroy(probe);
     double ke = hang(WC_INTEGRATOR_VERLET, fine, ref);
@@ -261,7 +245,7 @@ static void stiff(void)
         wc_grid_cloth_def def = wc_grid_cloth_def_default();
         def.count_u = def.count_v = n;
         def.material.stretch_stiffness = 1e9;
-        int32_t id = add_grid(w, &def);
+        int32_t id = scene_add_grid(w, &def);
         int32_t pins[2] = {0, n - 1};
         wc_cloth_pin(w, id, pins, 2);
         double stretch = 0.0, e0 = total_energy(w, id, NULL), mg = 0.15 * 9.81;
@@ -318,7 +302,7 @@ static void determinism(void)
             def.count_u = def.count_v = 65;
             def.center[2] = 0.31;
             def.wetness = 1.0;
-            int32_t id = add_grid(w, &def);
+            int32_t id = scene_add_grid(w, &def);
             CHECK(wc_cloth_particle_count(w, id) >= WC_PARALLEL_MIN, "cloth too small");
             int32_t pin = 0;
             wc_cloth_pin(w, id, &pin, 1);
@@ -359,7 +343,7 @@ static wrap_result wrap_run(wc_integrator integrator, double wetness)
     g.count_u = g.count_v = 20;
     g.center[2] = 0.6;
     g.wetness = wetness;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     wrap_result r;
     memset(&r, 0, sizeof r);
     double p[3 * 400];
@@ -423,7 +407,7 @@ static void drape_frames(wc_integrator integrator, int32_t substeps, double *out
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = DRAPE_N;
     g.center[2] = 0.6;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     for (int f = 0; f < DRAPE_FRAMES; ++f) {
         if (wc_world_advance(w, 1.0 / 24, substeps) != WC_OK) {
             CHECK(0, "drape frame %d: %s", f, wc_world_last_error(w));
@@ -481,7 +465,7 @@ static void stable_steps(void)
         wc_world *w = make_world(ALL[which], (double[3]){0.0, 0.0, -9.81}, 1);
         wc_grid_cloth_def def = wc_grid_cloth_def_default();
         def.count_u = def.count_v = 20;
-        add_grid(w, &def);
+        scene_add_grid(w, &def);
         dt[which] = wc_world_stable_dt(w);
         wc_world_destroy(w);
     }

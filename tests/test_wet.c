@@ -36,23 +36,7 @@ static wc_world *world_with_gravity(double gz)
     wc_world_def def = wc_world_def_default();
     def.thread_count = 1;
     def.gravity[2] = gz;
-    wc_world *w = NULL;
-    wc_message msg;
-    if (wc_world_create(&def, &w, &msg) != WC_OK) {
-        fprintf(stderr, "wc_world_create: %s\n", msg.text);
-        exit(1);
-    }
-    return w;
-}
-
-static int32_t add_grid(wc_world *w, const wc_grid_cloth_def *g)
-{
-    int32_t cl = -1;
-    if (wc_world_add_grid_cloth(w, g, &cl) != WC_OK) {
-        fprintf(stderr, "wc_world_add_grid_cloth: %s\n", wc_world_last_error(w));
-        exit(1);
-    }
-    return cl;
+    return scene_world_from(&def);
 }
 
 static void advance_or_fail(wc_world *w, double frame, int32_t substeps)
@@ -89,7 +73,7 @@ static uint64_t small_drop(const wc_material *m, double wetness)
     g.center[2] = 0.4;
     g.material = *m;
     g.wetness = wetness;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     for (int f = 0; f < 12; ++f) advance_or_fail(w, 1.0 / 24, 0);
     CHECK(wc_world_get_stats(w).collider_contacts > 20, "the dry-check cloth barely touches (%d)",
           wc_world_get_stats(w).collider_contacts);
@@ -158,7 +142,7 @@ static wrap_result wrap_run(double wetness)
     g.count_u = g.count_v = 20;
     g.center[2] = 0.6;
     g.wetness = wetness;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     wrap_result r;
     memset(&r, 0, sizeof r);
     double p[3 * 400], v[3 * 114], dist[400];
@@ -298,7 +282,7 @@ static spread_result spread_run(double adhesion, double bend)
     g.wetness = 1.0;
     g.material.adhesion = adhesion;
     g.material.bend_stiffness = bend;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     spread_result r;
     memset(&r, 0, sizeof r);
     for (int f = 1; f <= SPREAD_FRAMES; ++f) {
@@ -412,7 +396,7 @@ static slack_result slack_run(double wetness)
     g.count_u = g.count_v = n;
     for (int k = 0; k < 3; ++k) g.center[k] = 0.004 * normal[k], g.axis_v[k] = v[k];
     g.wetness = wetness;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     int32_t top[16];
     for (int i = 0; i < n; ++i) top[i] = (n - 1) * n + i;
     CHECK(wc_cloth_pin(w, cl, top, n) == WC_OK, "%s", wc_world_last_error(w));
@@ -519,7 +503,7 @@ static fold_result fold_run(double wetness)
     g.center[2] = 0.004;
     g.material.bend_stiffness = 5e-2;
     g.wetness = wetness;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     double p[3 * 21 * 5], p0[3 * 21 * 5];
     wc_cloth_get_positions(w, cl, p, count);
     for (int i = 0; i < count; ++i)
@@ -621,7 +605,7 @@ static spike_result spike_run(double q)
     g.wetness = 1.0;
     g.material.adhesion = 0.0;
     g.material.wet_friction = q;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     double vel[3 * 25], p[3 * 25], dist[25];
     for (int i = 0; i < 25; ++i) vel[3 * i] = 1.0, vel[3 * i + 1] = 0.0, vel[3 * i + 2] = 0.0;
     wc_cloth_set_velocities(w, cl, vel, 25);
@@ -690,7 +674,7 @@ static self_result self_run(double wetness)
     g.size_u = 1.0, g.size_v = 0.2;
     g.self_collision = 1;
     g.wetness = wetness;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     enum { N = FOLD_NU * FOLD_NV };
     double p[3 * N];
     int32_t pins[N], pin_count = 0;
@@ -851,7 +835,7 @@ static uint64_t wet_threads_run(int32_t threads, int *stuck)
     g.count_u = g.count_v = 64;
     g.center[2] = 0.004;
     g.wetness = 1.0;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     static double p[3 * 64 * 64], vel[3 * 64 * 64];
     wc_cloth_get_positions(w, cl, p, 64 * 64);
     for (int i = 0; i < 64 * 64; ++i)
@@ -907,7 +891,7 @@ static void wetness_api(void)
     wc_world *w = world_with_gravity(-9.81);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = 8;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     enum { N = 64 };
     double map[N], got[N], mass_before[N], mass_after[N];
     for (int i = 0; i < N; ++i) map[i] = (double)((i * 37) % 64) / 63.0; /* 0 .. 1, both ends included */
@@ -984,7 +968,7 @@ static void wicking(void)
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = 11;
     g.material.wicking = 0.01;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     enum { N = 121 };
     double map[N], got[N], dry_mass[N], total0 = 0.0;
     masses(w, cl, dry_mass, N);
@@ -1026,7 +1010,7 @@ static void drying(void)
     g.count_u = g.count_v = 6;
     g.material.drying = 0.5;
     g.wetness = 0.8;
-    int32_t cl = add_grid(w, &g);
+    int32_t cl = scene_add_grid(w, &g);
     double got[36], worst = 0.0;
     for (int f = 0; f < 24; ++f) {
         advance_or_fail(w, 1.0 / 24, 0);
@@ -1060,9 +1044,9 @@ static void wet_material(void)
         g.count_u = g.count_v = 10;
         g.material.wet_mass_gain = gains[k];
         g.material.wet_softening = softenings[k];
-        int32_t dry = add_grid(w, &g);
+        int32_t dry = scene_add_grid(w, &g);
         g.wetness = 1.0;
-        int32_t wet = add_grid(w, &g);
+        int32_t wet = scene_add_grid(w, &g);
         double m_dry[100], m_wet[100], worst = 0.0;
         masses(w, dry, m_dry, 100);
         masses(w, wet, m_wet, 100);
