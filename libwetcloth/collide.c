@@ -21,6 +21,8 @@
 /* A particle skips a collider while its clearance exceeds its drift by
  * this fraction of the contact distance: far more than rounding. */
 #define CLEARANCE_MARGIN 1e-6
+/* near_slot's answer for a particle its near list gives no triangle. */
+#define NO_CANDIDATES (-2)
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
@@ -354,14 +356,16 @@ static double particle_clearance(const particle_motion *m, const wc_collider *c,
 }
 
 /* The particle's slot in the near list's particle part when the list
- * holds for its motion and gives it candidates, else -1. */
+ * holds for its motion and gives it candidates; NO_CANDIDATES when it
+ * holds and gives none (nothing near: the particle is done with this
+ * collider); else -1. */
 static int32_t near_slot(const wc_near_list *near, const particle_motion *m, const wc_collider *c,
                          int32_t particle, double r, const int32_t **listed, int32_t *count)
 {
     if (!near || !wc_near_list_particle(near, c, 2 * r, particle, m->start[0], m->start[1],
                                         m->start[2], m->end[0], m->end[1], m->end[2], listed, count))
         return -1;
-    return near->particle_slot[particle];
+    return *count ? near->particle_slot[particle] : NO_CANDIDATES;
 }
 
 /* One mesh collider against one particle. In the first test of a particle
@@ -376,6 +380,7 @@ static int mesh_collider(particle_motion *m, const wc_collider *c, wc_near_list 
 {
     const int32_t *listed = NULL;
     int32_t count = 0, slot = first && fs ? near_slot(near, m, c, particle, r, &listed, &count) : -1;
+    if (slot == NO_CANDIDATES) return 0;
     wc_near_elements *kept = near ? &near->particles : NULL;
     if (slot >= 0 && wc_feature_state_drift(fs, particle, kept->path_at[slot]) + CLEARANCE_MARGIN * r <
                          kept->least_clearance[slot])

@@ -19,6 +19,16 @@
  * a violation of the whole contact distance, so 1 % of it left over is
  * harmless, and stopping there spares passes and fail-safes. */
 #define SLACK 1e-2
+/* Clearances (near_list.h) are measured from this fraction of the contact
+ * distance, the reach of a contact: a pair counts as one only nearer than
+ * r sqrt(1 - SLACK) = 0.99499 r, 1.3e-5 r less than the reach, which is
+ * far more than the rounding of the few operations behind a clearance.
+ * Measured from r instead, a pair the last push left at exactly r would
+ * have no clearance, and a cloth resting on the collider would test every
+ * pair in contact at every step although it must sink 0.5 % of r before
+ * one can count (the 20 x 20 drape in its second second: a third of its
+ * pair tests, 394 per step against 269 with the reach). */
+#define REACH 0.995
 
 struct wc_feature_state {
     int32_t triangle_count;
@@ -33,6 +43,11 @@ struct wc_feature_state {
     /// last one's are what the fail-safe sends back).
     uint8_t *moved;
     uint8_t *moving;
+    /// The same as lists (in the order marked), so that a pass after the
+    /// first and the near lists' check find them without reading a flag per
+    /// particle; a flag array is zero but for its list's entries.
+    int32_t *moved_list, *moving_list;
+    int32_t moved_count, moving_count;
     /// Per particle, xyz: how far the collider feature that last pushed it
     /// moved over the step. The fail-safe carries the particle along by it.
     double *carry;
@@ -168,6 +183,8 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
     s->triangle_edges = wc_alloc_array(3 * (size_t)nt, sizeof *s->triangle_edges);
     s->moved = wc_alloc_array((size_t)c->particle_count, sizeof *s->moved);
     s->moving = wc_alloc_array((size_t)c->particle_count, sizeof *s->moving);
+    s->moved_list = wc_alloc_array((size_t)c->particle_count, sizeof *s->moved_list);
+    s->moving_list = wc_alloc_array((size_t)c->particle_count, sizeof *s->moving_list);
     s->carry = wc_alloc_array(3 * (size_t)c->particle_count, sizeof *s->carry);
     s->marks.recheck = wc_alloc_array((size_t)c->particle_count, sizeof *s->marks.recheck);
     s->marks.shifted = wc_alloc_array((size_t)c->particle_count, sizeof *s->marks.shifted);
@@ -178,6 +195,7 @@ wc_feature_state *wc_feature_state_create(const wc_cloth *c)
     s->found_capacity = 256;
     s->found = wc_alloc_array((size_t)s->found_capacity, sizeof *s->found);
     if (!entries || !s->edges || !s->triangle_edges || !s->moved || !s->moving ||
+        !s->moved_list || !s->moving_list ||
         !s->carry || !s->marks.recheck || !s->marks.shifted || !s->path || !s->path_end ||
         !s->motion2 || !s->path_start || !s->found) {
         wc_free(entries);
@@ -226,6 +244,8 @@ void wc_feature_state_destroy(wc_feature_state *s)
     wc_free(s->triangle_edges);
     wc_free(s->moved);
     wc_free(s->moving);
+    wc_free(s->moved_list);
+    wc_free(s->moving_list);
     wc_free(s->carry);
     wc_free(s->marks.recheck);
     wc_free(s->marks.shifted);
@@ -397,7 +417,7 @@ static int push_element(wc_cloth *c, wc_feature_state *s, const int32_t *idx, co
             c->contact[i] = WC_CONTACT_COLLIDER;
             c->normal_x[i] = n[0], c->normal_y[i] = n[1], c->normal_z[i] = n[2];
         }
-        s->moving[i] = 1;
+        if (!s->moving[i]) s->moving[i] = 1, s->moving_list[s->moving_count++] = i;
         s->marks.recheck[i] = 1;
         for (int d = 0; d < 3; ++d) s->carry[3 * (size_t)i + d] = v_feature[d] * dt;
     }
@@ -655,10 +675,11 @@ static int must_visit(const wc_feature_state *s, const wc_near_elements *near, i
  * (the pair cannot touch), from the boxes. Negative when the pair must be
  * tested.
  *
- * A skipped pair is at least its clearance beyond r apart, and a contact
- * needs it nearer than r sqrt(1 - SLACK), 0.5 % of r nearer still: far
- * more than the rounding of the few operations behind a clearance, so
- * skipping never misses a contact the test would have found. */
+ * A skipped pair is at least its clearance beyond the reach (REACH r)
+ * apart, and a contact needs it nearer than r sqrt(1 - SLACK), 1.3e-5 r
+ * nearer still: far more than the rounding of the few operations behind a
+ * clearance, so skipping never misses a contact the test would have
+ * found. */
 static double untested_clearance(const wc_cloth *c, const wc_near_elements *near, int32_t k,
                                  int32_t j, element_visit *v, const double *feature_box, int ccd,
                                  double r)
@@ -668,7 +689,7 @@ static double untested_clearance(const wc_cloth *c, const wc_near_elements *near
     if (wc_boxes_overlap(v->box, feature_box)) return -1.0;
     if (!near) return 0.0;
     if (!v->has_end) end_box(c, v->idx, v->count, v->end), v->has_end = 1;
-    return max2(0.0, box_gap(v->end, feature_box) - r);
+    return max2(0.0, box_gap(v->end, feature_box) - REACH * r);
 }
 
 /* Collider vertices against cloth triangles, or collider edges against
@@ -745,7 +766,7 @@ static int visit_element(wc_cloth *c, wc_feature_state *s, const wc_collider *co
         if (clear < 0.0) {
             double d2;
             pushed |= test_pair(c, s, col, kind, element, f, ccd, r, mu, dt, &d2);
-            clear = sqrt(d2) - r;
+            clear = sqrt(d2) - REACH * r;
         }
         if (near) near->clearance[near->start[k] + j] = clear;
         least = min2(least, clear);
@@ -758,14 +779,14 @@ static int visit_element(wc_cloth *c, wc_feature_state *s, const wc_collider *co
  * ids) with a particle the last pass moved; returns how many. They are
  * marked first and then read off in order between the least and the
  * greatest marked, which spares a sort. */
-static int32_t moved_elements(const wc_cloth *c, wc_feature_state *s, const wc_near_elements *near,
+static int32_t moved_elements(wc_feature_state *s, const wc_near_elements *near,
                               const element_kind *kind)
 {
     const int32_t *start = kind->count == 3 ? s->triangles_start : s->edges_start;
     const int32_t *items = kind->count == 3 ? s->triangles_of : s->edges_of;
     int32_t lo = INT32_MAX, hi = -1;
-    for (int32_t i = 0; i < c->particle_count; ++i) {
-        if (!s->moved[i]) continue;
+    for (int32_t m = 0; m < s->moved_count; ++m) {
+        int32_t i = s->moved_list[m];
         for (int32_t j = start[i]; j < start[i + 1]; ++j) {
             int32_t k = near ? near->slot_of[items[j]] : items[j];
             if (k < 0) continue;
@@ -790,7 +811,7 @@ static int element_pass(wc_cloth *c, wc_feature_state *s, const wc_collider *col
                         double dt)
 {
     int moved = 0;
-    int32_t count = s->only_moved ? moved_elements(c, s, near, kind)
+    int32_t count = s->only_moved ? moved_elements(s, near, kind)
                     : near        ? near->count
                     : kind->count == 3 ? s->triangle_count : s->edge_count;
     for (int32_t m = 0; m < count; ++m) {
@@ -844,11 +865,19 @@ static wc_near_list *near_list_for(wc_cloth *c, wc_feature_state *s, int32_t k,
     /* the particle pass grows its query boxes by twice the contact distance */
     /* in a pass after the first only the particles that pass marked moved
      * can have left their boxes since the list was last found to hold */
-    if (wc_near_list_holds(l, c, col, r_triangles, r, 2 * r, s->only_moved ? s->moved : NULL))
+    if (wc_near_list_holds(l, c, col, r_triangles, r, 2 * r, s->only_moved ? s->moved_list : NULL,
+                           s->moved_count))
         return l;
     if (wc_near_list_build(l, c, s->edges, s->edge_count, col, r_triangles, r, 2 * r))
         return *failed = 1, NULL;
     return l;
+}
+
+/* Zeroes a flag array through its list and empties the list. */
+static void clear_marks(uint8_t *flags, const int32_t *list, int32_t *count)
+{
+    for (int32_t k = 0; k < *count; ++k) flags[list[k]] = 0;
+    *count = 0;
 }
 
 wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *const *colliders,
@@ -864,14 +893,17 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
     s->r_max = r_max;
     /* the first pass looks at what the particle pass moved as if a pass of
      * its own had moved it */
-    if (!all) memcpy(s->moved, s->marks.shifted, (size_t)c->particle_count);
+    clear_marks(s->moved, s->moved_list, &s->moved_count);
+    clear_marks(s->moving, s->moving_list, &s->moving_count);
+    for (int32_t i = 0; i < c->particle_count && !all; ++i)
+        if (s->marks.shifted[i]) s->moved[i] = 1, s->moved_list[s->moved_count++] = i;
     memset(s->marks.shifted, 0, (size_t)c->particle_count);
     /* the particles' paths are up to date: wc_feature_state_begin_step
      * started them for this step, and every move since was tracked */
     int moved = 1;
     for (int pass = 0; pass < MAX_PASSES && moved; ++pass) {
         s->only_moved = pass > 0 || !all;
-        memset(s->moving, 0, (size_t)c->particle_count);
+        clear_marks(s->moving, s->moving_list, &s->moving_count);
         moved = 0;
         for (int32_t k = 0; k < count; ++k) {
             const wc_collider *col = colliders[k];
@@ -886,6 +918,9 @@ wc_status wc_collide_features(wc_cloth *c, wc_feature_state *s, wc_collider *con
         }
         uint8_t *swap = s->moved;
         s->moved = s->moving, s->moving = swap;
+        int32_t *swap_list = s->moved_list, swap_count = s->moved_count;
+        s->moved_list = s->moving_list, s->moved_count = s->moving_count;
+        s->moving_list = swap_list, s->moving_count = swap_count;
         *moved_out |= moved;
     }
     if (!moved) return WC_OK;

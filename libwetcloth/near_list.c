@@ -49,13 +49,15 @@ static int made_for(const wc_near_list *l, const wc_collider *col)
 }
 
 int wc_near_list_holds(const wc_near_list *l, const wc_cloth *c, const wc_collider *col,
-                       double r_triangles, double r_edges, double r_particles, const uint8_t *only)
+                       double r_triangles, double r_edges, double r_particles, const int32_t *only,
+                       int32_t only_count)
 {
     if (!made_for(l, col) || l->r_triangles != r_triangles || l->r_edges != r_edges ||
         l->r_particles != r_particles || l->particle_count != c->particle_count)
         return 0;
-    for (int32_t i = 0; i < c->particle_count; ++i) {
-        if (only && !only[i]) continue;
+    int32_t count = only ? only_count : c->particle_count;
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t i = only ? only[k] : k;
         const double *box = l->particle_boxes + 6 * (size_t)i;
         if (!inside(box, c->x[i], c->y[i], c->z[i]) || !inside(box, c->nx[i], c->ny[i], c->nz[i]))
             return 0;

@@ -25,7 +25,8 @@
 ///
 /// Clearances (kept by the feature pass, collide_features.c): the element's
 /// particles may go this far from where they were when measured before a
-/// candidate could come within the contact distance. A cloth resting on a
+/// candidate could come within reach of a contact (collide_features.c, REACH:
+/// a little less than the contact distance). A cloth resting on a
 /// collider stays near the same features step after step and moves a tiny
 /// part of its clearance, so most pairs need no distance computed: the
 /// distance between a collider feature and a cloth element changes by no
@@ -83,11 +84,11 @@ void wc_near_list_free(wc_near_list *list);
 
 /// Whether the lists still hold for this step's motion (x -> nx) of the
 /// cloth against this collider with these contact distances. With `only`,
-/// only the particles it marks are checked (the others have not moved
-/// since the lists were last found to hold).
+/// only the only_count particles it lists are checked (the others have not
+/// moved since the lists were last found to hold).
 int wc_near_list_holds(const wc_near_list *list, const wc_cloth *cloth, const wc_collider *collider,
                        double r_triangles, double r_edges, double r_particles,
-                       const uint8_t *only);
+                       const int32_t *only, int32_t only_count);
 
 /// For one particle of the particle pass: whether the list was made for
 /// this collider (unchanged) with this r_particles and the particle is
