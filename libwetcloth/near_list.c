@@ -189,13 +189,20 @@ wc_status wc_near_list_build(wc_near_list *l, const wc_cloth *c, const int32_t *
         l->particle_count = l->particle_boxes && l->particle_slot ? n : 0;
         if (!l->particle_count) return WC_ERROR_OUT_OF_MEMORY;
     }
+    /* Each box reaches from the start of the step to as far again past its
+     * end (where the next step takes the particle if its velocity holds),
+     * grown by the margin: round this step's motion alone, a particle
+     * moving more than the margin per step (the drape's falling cloth at 20
+     * XPBD substeps per frame) left it at the next step, and every listed
+     * element's clearances, unknown after a build, were measured again. */
     double margin = MARGIN_CELLS * col->vertex_grid.cell_size;
     for (int32_t i = 0; i < c->particle_count; ++i) {
         double *box = l->particle_boxes + 6 * (size_t)i;
         double start[3] = {c->x[i], c->y[i], c->z[i]}, end[3] = {c->nx[i], c->ny[i], c->nz[i]};
         for (int k = 0; k < 3; ++k) {
-            box[k] = (start[k] < end[k] ? start[k] : end[k]) - margin;
-            box[k + 3] = (start[k] > end[k] ? start[k] : end[k]) + margin;
+            double ahead = end[k] + (end[k] - start[k]);
+            box[k] = (start[k] < ahead ? start[k] : ahead) - margin;
+            box[k + 3] = (start[k] > ahead ? start[k] : ahead) + margin;
         }
     }
     wc_status s = list_elements(l, &l->triangles, c->topology.triangles, 3,

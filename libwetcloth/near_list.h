@@ -66,7 +66,8 @@ typedef struct wc_near_list {
     double r_particles;
     int built;
     /// Per particle: box (min xyz, max xyz) it must stay in for the lists to
-    /// hold: its start and end positions at the build, grown by the margin.
+    /// hold: from its start position at the build to as far again past its
+    /// end, grown by the margin.
     double *particle_boxes;
     int32_t particle_count;
     /// Collider vertices near each cloth triangle, collider edges near each
