@@ -867,7 +867,13 @@ int wc_convex_resolve(const wc_convex_shape *shape, const double a[3], const dou
      * anything: the distance to the surface changes by at most the motion,
      * so its path never gets deeper than half its motion beyond where it
      * ends or starts. Only faster ones need the sweep. */
-    if (len > r) {
+    /* A path whose length overflows (a coordinate near the double range or
+     * infinite, as an exploded cloth's can be once taken into the shape's
+     * frame) is not swept: bisecting it would hand libccd infinities, and
+     * its EPA reads through a NULL pointer on those (found by fuzzing).
+     * Such a particle has moved more than ~1e154 m in one step; only where
+     * it ends is checked. */
+    if (len > r && isfinite(len)) {
         double da, va[3];
         int in_a = wc_convex_penetration(shape, a, r, &da, va);
         /* The sweep with half the radius asks whether the path really went
@@ -928,6 +934,12 @@ int wc_convex_triangle_intersects(const wc_convex_shape *shape, const wc_pose *p
         tri.center[k] = (tri.a[k] + tri.b[k] + tri.c[k]) / 3.0;
     }
     if (gap2 > shape->bound_radius * shape->bound_radius) return 0;
+    /* A vertex that is not finite in the shape's frame (or a triangle so
+     * large its centre overflows) gets no answer from libccd, only
+     * infinities inside GJK, as wc_convex_resolve's overflowing paths did
+     * inside EPA: it is not counted. */
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(tri.center[k])) return 0;
     shape_obj so = {shape, {0.0, 0.0, 0.0}, 0, SUPPORT_BUDGET};
     interior_point(shape, so.center);
     ccd_t ccd;

@@ -605,6 +605,12 @@ static void test_triangles(void)
     CHECK(wc_convex_triangle_intersects(&s, &turned, t1, t2, t3), "triangle at the turned box's edge");
     t1[0] = t2[0] = t3[0] = x + 0.001;
     CHECK(!wc_convex_triangle_intersects(&s, &turned, t1, t2, t3), "triangle beyond the turned box");
+    /* a vertex at infinity or NaN (an exploded cloth): not counted, and
+     * libccd is not asked */
+    double bad[3] = {0.0, 0.0, INFINITY}, o1[3] = {0, 0, 0}, o2[3] = {0.1, 0, 0};
+    CHECK(!wc_convex_triangle_intersects(&s, &turned, o1, o2, bad), "triangle with an infinite vertex");
+    bad[2] = NAN;
+    CHECK(!wc_convex_triangle_intersects(&s, &turned, o1, o2, bad), "triangle with a NaN vertex");
     wc_convex_shape_free(&s);
 }
 
@@ -789,9 +795,39 @@ static void test_exploded_path(void)
     wc_convex_shape_free(&s);
 }
 
+/* A particle whose end position, taken into a hull's frame, overflowed to
+ * infinity (the coordinates of a fuzz input that crashed: the first contact
+ * bisected that path and handed libccd's EPA an infinite point, which read
+ * through NULL). Checked: no contact is reported for the infinite end; an
+ * end inside the hull after a path too long for a double is still pushed
+ * out onto the surface; a finite end far away after such a path is left
+ * alone. */
+static void test_overflowing_path(void)
+{
+    static const double pts[18] = {-0.2, -0.2, -0.2, -0.2,    -0.2,     0, -0.2, 0.2, -0.2,
+                                   0.2,  0.2,  0,    -0.00625, -0.40625, 0, -0.2, -0.2, 0};
+    wc_convex_collider_def d = hull_def(pts, 6);
+    wc_convex_shape s = make(&d);
+    double r = 0x1.47ae147ae147bp-8, out[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+    const double a[3] = {-0x1p-2, -0x1p-2, 0.0};
+    const double b[3] = {-0x1.1ccf385ebc89fp+1023, -0x1p+971, INFINITY};
+    CHECK(!wc_convex_resolve(&s, a, b, r, out, n), "infinite end reported as a contact");
+    /* from ~1.5e308 m away into the hull, 0.05 m under its top face z = 0 */
+    const double far[3] = {-1.5e308, 0.0, -1.5e308}, inside[3] = {-0.1, -0.15, -0.05};
+    CHECK(wc_convex_resolve(&s, far, inside, r, out, n), "end inside the hull not pushed out");
+    double depth = 0.0, dir[3];
+    CHECK(isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]), "pushed-out end not finite");
+    CHECK(!wc_convex_penetration(&s, out, r * (1.0 - 1e-9), &depth, dir),
+          "pushed-out end still inside by %g", depth);
+    const double gone[3] = {1.5e308, 0.0, 1.5e308};
+    CHECK(!wc_convex_resolve(&s, far, gone, r, out, n), "far path with a far end reported as a contact");
+    wc_convex_shape_free(&s);
+}
+
 int main(void)
 {
     test_exploded_path();
+    test_overflowing_path();
     for (int i = 0; i < 8; ++i)
         for (int k = 0; k < 3; ++k) cube_points[3 * i + k] = (i >> k) & 1 ? 0.5 : -0.5;
     test_sphere_points();
