@@ -78,6 +78,11 @@ typedef struct wc_near_list {
     /// particle is in that list (-1: it found none).
     wc_near_elements particles;
     int32_t *particle_slot;
+    /// Where a rebuild that keeps what still holds writes the new lists
+    /// before they replace the old (swapped, so both keep their buffers),
+    /// and which particles left their boxes.
+    wc_near_elements spare;
+    uint8_t *left;
 } wc_near_list;
 
 void wc_near_list_init(wc_near_list *list);
@@ -104,6 +109,11 @@ int wc_near_list_particle(const wc_near_list *list, const wc_collider *collider,
 /// triangles against its vertex grid (boxes grown by r_triangles), cloth
 /// edges (edges: 2 particles each) against its edge grid (grown by
 /// r_edges), particles against its triangle grid (grown by r_particles).
+/// Lists made for the same collider and distances are rebuilt only where
+/// they no longer hold: the particles that left their boxes get new ones,
+/// the elements with such a particle are asked again, and every other
+/// element keeps its candidates and clearances (what it would be given
+/// again, since its box has not changed).
 /// WC_ERROR_OUT_OF_MEMORY on failure (the list is then unbuilt).
 wc_status wc_near_list_build(wc_near_list *list, const wc_cloth *cloth, const int32_t *edges,
                              int32_t edge_count, const wc_collider *collider, double r_triangles,
