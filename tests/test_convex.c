@@ -1,7 +1,8 @@
 /* Convex colliders (convex.c): ball penetration against closed forms for
  * every shape (chosen positions on faces, edges and corners, then random
  * positions), a random hull against brute-force facets, the swept resolve
- * of fast particles, triangle tests, poses, and validation messages. */
+ * of fast particles, triangle tests, poses, validation messages, and paths
+ * with coordinates anywhere in the doubles (infinite and NaN included). */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -824,9 +825,52 @@ static void test_overflowing_path(void)
     wc_convex_shape_free(&s);
 }
 
+/* A coordinate anywhere in the doubles: near the shape, far, enormous,
+ * infinite or NaN, with either sign. */
+static double extreme_coordinate(void)
+{
+    double u = uniform(0.0, 1.0), sign = uniform(0.0, 1.0) < 0.5 ? -1.0 : 1.0;
+    if (u < 0.4) return uniform(-2.0, 2.0);
+    if (u < 0.8) return sign * pow(10.0, uniform(-300.0, 308.0));
+    if (u < 0.9) return sign * 1.7976931348623157e308;
+    return u < 0.95 ? sign * INFINITY : NAN;
+}
+
+/* wc_convex_resolve and wc_convex_penetration on paths and points from
+ * extreme_coordinate, against every kind of shape: libccd is never handed
+ * something it cannot take (the sanitizer build would see a bad read, as it
+ * did for the overflowing path above), and whatever is returned is finite:
+ * a position on the surface and a unit normal. */
+static void test_extreme_inputs(void)
+{
+    wc_convex_collider_def defs[4] = {sphere_def(0.4), capsule_def(0.2, 0.3), box_def(0.3, 0.2, 0.1),
+                                      hull_def(octa_points, 6)};
+    int hits = 0, bad = 0;
+    for (int d = 0; d < 4; ++d) {
+        wc_convex_shape s = make(&defs[d]);
+        for (int trial = 0; trial < 3000; ++trial) {
+            double a[3], b[3], out[3], n[3], depth, dir[3];
+            for (int k = 0; k < 3; ++k) a[k] = extreme_coordinate(), b[k] = extreme_coordinate();
+            if (trial % 3 == 0) memcpy(a, b, sizeof a);
+            if (wc_convex_resolve(&s, a, b, 0.005, out, n)) {
+                ++hits;
+                bad += !(isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]) && fabs(len(n) - 1.0) < 1e-9);
+            }
+            if (wc_convex_penetration(&s, b, 0.005, &depth, dir))
+                bad += !(isfinite(depth) && depth > 0.0 && fabs(len(dir) - 1.0) < 1e-9);
+        }
+        wc_convex_shape_free(&s);
+    }
+    printf("extreme inputs: 12000 paths, %d contacts, %d with a non-finite or non-unit answer\n", hits,
+           bad);
+    CHECK(bad == 0, "%d answers not finite", bad);
+    CHECK(hits > 100, "only %d of the paths touched a shape: the test is not testing", hits);
+}
+
 int main(void)
 {
     test_exploded_path();
+    test_extreme_inputs();
     test_overflowing_path();
     for (int i = 0; i < 8; ++i)
         for (int k = 0; k < 3; ++k) cube_points[3 * i + k] = (i >> k) & 1 ? 0.5 : -0.5;
