@@ -60,7 +60,7 @@ static wc_status mesh_begin_step(wc_collider *c, double share)
     if (c->moving && share >= 1.0)
         memcpy(c->next, c->target, nv * sizeof *c->next); /* exactly there: static again */
     else if (c->moving)
-        for (size_t k = 0; k < nv; ++k) c->next[k] = c->current[k] + (c->target[k] - c->current[k]) * share;
+        for (size_t k = 0; k < nv; ++k) c->next[k] = wc_lerp(c->current[k], c->target[k], share);
     else if (c->grid_static)
         return WC_OK; /* static and indexed: nothing to do */
     else

@@ -32,6 +32,7 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "primitives.h"
 #include "status.h"
 
 /* Limits of the description (wetcloth.h). */
@@ -133,7 +134,7 @@ void wc_pose_lerp(const wc_pose *a, const wc_pose *b, double t, wc_pose *out)
         return;
     }
     wc_pose r;
-    for (int k = 0; k < 3; ++k) r.position[k] = a->position[k] + (b->position[k] - a->position[k]) * t;
+    for (int k = 0; k < 3; ++k) r.position[k] = wc_lerp(a->position[k], b->position[k], t);
     /* q and -q are the same rotation: blend toward whichever of them is
      * nearer, so the interpolation takes the shorter arc. */
     double d = 0.0;

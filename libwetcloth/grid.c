@@ -58,6 +58,11 @@ static int64_t cells_in(const int32_t lo[3], const int32_t hi[3])
     int64_t cells = 1;
     for (int k = 0; k < 3; ++k) {
         int64_t span = (int64_t)hi[k] - lo[k] + 1;
+        /* An empty box (min above max on an axis: the box of corners whose
+         * coordinates there are all NaN) covers no cell. Its negative span
+         * once went into the entry count while the insertion loops wrote
+         * the other items' cells past the end (found by fuzzing). */
+        if (span <= 0) return 0;
         if (span > CELLS_SATURATE) return CELLS_SATURATE;
         cells *= span;
         if (cells > CELLS_SATURATE) return CELLS_SATURATE;

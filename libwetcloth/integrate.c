@@ -3,11 +3,12 @@
 #include <math.h>
 
 #include "parallel.h"
+#include "primitives.h"
 
 void wc_pinned_position(const wc_cloth *c, int32_t slot, double fraction, double out[3])
 {
     const double *from = c->pins.from + 3 * (size_t)slot, *to = c->pins.to + 3 * (size_t)slot;
-    for (int k = 0; k < 3; ++k) out[k] = fraction == 1.0 ? to[k] : from[k] + (to[k] - from[k]) * fraction;
+    for (int k = 0; k < 3; ++k) out[k] = fraction == 1.0 ? to[k] : wc_lerp(from[k], to[k], fraction);
 }
 
 /* One Verlet step's constants (see wc_integrate_verlet). */

@@ -4,6 +4,20 @@
 #ifndef WC_PRIMITIVES_H
 #define WC_PRIMITIVES_H
 
+#include <math.h>
+
+/// a + (b - a) t, t in [0, 1]: where a motion is spread over substeps. Where
+/// b - a overflows (a and b near the ends of the double range with opposite
+/// signs) the weighted sum a (1 - t) + b t instead, which stays between
+/// them: the usual form gave infinity and then NaN (a collider's vertices
+/// went NaN mid-advance and stayed so; found by fuzzing). Otherwise the
+/// usual form, bit for bit.
+static inline double wc_lerp(double a, double b, double t)
+{
+    double d = b - a;
+    return isfinite(d) ? a + d * t : a * (1.0 - t) + b * t;
+}
+
 /// Closest point of triangle (a, b, c) to p. Returns the squared distance and
 /// writes the barycentric coordinates (weights of a, b, c) of the closest point.
 double wc_point_triangle_closest(const double p[3], const double a[3], const double b[3],

@@ -4,9 +4,12 @@
 #include <string.h>
 #include <time.h>
 
+#include "collider.h"
 #include "grid.h"
+#include "primitives.h"
 #include "test_util.h"
 #include "wetcloth.h"
+#include "world.h"
 
 static wc_world *world(void)
 {
@@ -63,6 +66,67 @@ static void grid_awkward_boxes(void)
     n = wc_grid_query(&g, nan_box, found, 8);
     CHECK(n >= 0 && n <= 4, "a NaN query returns a count (%d)", (int)n);
     wc_grid_free(&g);
+}
+
+/* An empty box (min above max on an axis: the box of triangle corners whose
+ * coordinates there were all NaN) among ordinary ones: its negative cell
+ * span went into the entry count, and the other items' cells were written
+ * past the end of the entries (heap overflow under ASan; found by
+ * fuzzing). It covers no cell and no query finds it. */
+static void grid_empty_box(void)
+{
+    double boxes[5 * 6] = {
+        0.0, 0.0, 0.0, 0.1, 0.1, 0.1,
+        0.05, 0.0, INFINITY, 0.3, 0.1, -INFINITY, /* empty along z */
+        0.2, 0.2, 0.2, 0.3, 0.3, 0.3,
+        0.0, 0.0, 0.0, 0.35, 0.35, 0.35,
+        INFINITY, 0.0, 0.0, -INFINITY, 0.1, 0.1, /* empty along x */
+    };
+    wc_grid g;
+    wc_grid_init(&g);
+    CHECK(wc_grid_build(&g, boxes, 5, 0.1) == WC_OK, "build");
+    int32_t found[8];
+    double everything[6] = {-10.0, -10.0, -10.0, 10.0, 10.0, 10.0};
+    int32_t n = wc_grid_query(&g, everything, found, 8);
+    CHECK(n == 3 && found[0] == 0 && found[1] == 2 && found[2] == 3,
+          "a query over everything finds the three boxes that are not empty (%d found)", (int)n);
+    double q[6] = {0.21, 0.21, 0.21, 0.22, 0.22, 0.22};
+    n = wc_grid_query(&g, q, found, 8);
+    CHECK(n == 2 && found[0] == 2 && found[1] == 3, "a small query finds boxes 2 and 3 (%d found)", (int)n);
+    wc_grid_free(&g);
+}
+
+/* A mesh collider moved from near the most negative double to near the
+ * largest: across the substeps its vertices were current + (target -
+ * current) * share, the difference overflowed, and they became NaN, which
+ * stayed in the collider after the step (found by fuzzing; their empty
+ * boxes then overflowed the grid above). Every substep's vertices are
+ * finite now, and the usual interpolation keeps its bits. */
+static void collider_across_the_doubles(void)
+{
+    CHECK(wc_lerp(-1.5e308, 1.5e308, 0.5) == 0.0 && wc_lerp(-1.5e308, 1.5e308, 0.25) == -0.75e308,
+          "lerp across the doubles: %g, %g", wc_lerp(-1.5e308, 1.5e308, 0.5),
+          wc_lerp(-1.5e308, 1.5e308, 0.25));
+    CHECK(wc_lerp(0.1, 0.7, 0.3) == 0.1 + (0.7 - 0.1) * 0.3, "lerp changed its bits");
+    wc_world *w = world();
+    double v[9] = {-1.5e308, 0.0, 0.0, -1.5e308, 1.0, 0.0, -1.5e308, 0.0, 1.0};
+    int32_t tri[3] = {0, 1, 2}, id;
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertices = v;
+    d.vertex_count = 3;
+    d.triangles = tri;
+    d.triangle_count = 1;
+    CHECK(wc_world_add_mesh_collider(w, &d, &id) == WC_OK, "collider: %s", wc_world_last_error(w));
+    for (int k = 0; k < 9; k += 3) v[k] = 1.5e308;
+    CHECK(wc_collider_set_vertices(w, id, v, 3) == WC_OK, "move: %s", wc_world_last_error(w));
+    wc_collider *c = w->colliders[id];
+    int bad = 0;
+    for (int step = 1; step <= 4; ++step) {
+        CHECK(wc_collider_begin_step(c, step / 4.0) == WC_OK, "begin step %d", step);
+        for (int k = 0; k < 9; ++k) bad += !isfinite(c->next[k]);
+    }
+    CHECK(bad == 0, "%d collider coordinates not finite across the substeps", bad);
+    wc_world_destroy(w);
 }
 
 /* Wicking over a link far shorter than the rest of the cloth: with 1e-6 m
@@ -213,6 +277,8 @@ int main(void)
     cloth_through_box_centre();
     pin_targets_without_pins();
     grid_awkward_boxes();
+    grid_empty_box();
+    collider_across_the_doubles();
     wicking_tiny_link(1e-6);
     wicking_tiny_link(1e-9);
     return test_report("test_robustness");
