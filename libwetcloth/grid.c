@@ -118,6 +118,7 @@ wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double c
         cell_range(boxes + 6 * (size_t)i, inv, lo, hi);
         memcpy(g->corner + 3 * (size_t)i, lo, sizeof lo);
         int64_t cells = cells_in(lo, hi);
+        if (cells == 0) continue; /* empty: in no cell, and no loop over its other axes */
         if (cells > MAX_CELLS_PER_ITEM) {
             ++large;
             continue;
@@ -142,8 +143,9 @@ wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double c
     for (int32_t i = 0; i < count; ++i) {
         int32_t lo[3], hi[3];
         cell_range(boxes + 6 * (size_t)i, inv, lo, hi);
-        if (cells_in(lo, hi) > MAX_CELLS_PER_ITEM) g->large[g->large_count++] = i;
-        else insert_item(g, i, lo, hi, fill, 1);
+        int64_t cells = cells_in(lo, hi);
+        if (cells > MAX_CELLS_PER_ITEM) g->large[g->large_count++] = i;
+        else if (cells > 0) insert_item(g, i, lo, hi, fill, 1);
     }
     /* Duplicates skipped in pass 1 leave gaps at bucket ends; close them so
      * start[] describes the filled entries exactly. */
@@ -210,7 +212,12 @@ int32_t wc_grid_query(const wc_grid *g, const double box[6], int32_t *out, int32
         if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)g->large[k])) n = emit(out, n, capacity, g->large[k]);
     int32_t lo[3], hi[3];
     cell_range(box, 1.0 / g->cell_size, lo, hi);
-    if (cells_in(lo, hi) > MAX_CELLS_PER_QUERY) {
+    int64_t cells = cells_in(lo, hi);
+    /* An empty query box (min above max on an axis) meets nothing; looping
+     * over its other axes, up to 2e9 cells each, never ended (found by
+     * fuzzing). */
+    if (cells == 0) return n;
+    if (cells > MAX_CELLS_PER_QUERY) {
         n = 0; /* scan all instead, in order (the large items come again) */
         for (int32_t i = 0; i < g->item_count; ++i)
             if (wc_boxes_overlap(box, g->boxes + 6 * (size_t)i)) n = emit(out, n, capacity, i);

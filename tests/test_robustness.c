@@ -72,7 +72,8 @@ static void grid_awkward_boxes(void)
  * coordinates there were all NaN) among ordinary ones: its negative cell
  * span went into the entry count, and the other items' cells were written
  * past the end of the entries (heap overflow under ASan; found by
- * fuzzing). It covers no cell and no query finds it. */
+ * fuzzing). It covers no cell and no query finds it; an empty query box
+ * finds nothing, without visiting the cells of its other axes. */
 static void grid_empty_box(void)
 {
     double boxes[5 * 6] = {
@@ -93,6 +94,17 @@ static void grid_empty_box(void)
     double q[6] = {0.21, 0.21, 0.21, 0.22, 0.22, 0.22};
     n = wc_grid_query(&g, q, found, 8);
     CHECK(n == 2 && found[0] == 2 && found[1] == 3, "a small query finds boxes 2 and 3 (%d found)", (int)n);
+    /* empty along x, the whole double range along y and z: the query
+     * looped over 2e9 x 2e9 cells of y and z (a fuzz input's timeout) */
+    double empty_query[6] = {INFINITY, -1e300, -1e300, -INFINITY, 1e300, 1e300};
+    n = wc_grid_query(&g, empty_query, found, 8);
+    CHECK(n == 0, "an empty query finds nothing (%d found)", (int)n);
+    wc_grid_free(&g);
+    double wide_empty[6] = {INFINITY, -1e300, -1e300, -INFINITY, 1e300, 1e300};
+    wc_grid_init(&g);
+    CHECK(wc_grid_build(&g, wide_empty, 1, 0.1) == WC_OK, "build with an empty box spanning y and z");
+    n = wc_grid_query(&g, everything, found, 8);
+    CHECK(n == 0, "the empty box is found (%d)", (int)n);
     wc_grid_free(&g);
 }
 
