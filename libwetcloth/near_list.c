@@ -44,6 +44,12 @@ static int inside(const double box[6], double x, double y, double z)
     return x >= box[0] && x <= box[3] && y >= box[1] && y <= box[4] && z >= box[2] && z <= box[5];
 }
 
+/* Whether particle i's motion this step (start and end) lies in box. */
+static int motion_inside(const double box[6], const wc_cloth *c, int32_t i)
+{
+    return inside(box, c->x[i], c->y[i], c->z[i]) && inside(box, c->nx[i], c->ny[i], c->nz[i]);
+}
+
 /* Made for this collider, which has not changed since. */
 static int made_for(const wc_near_list *l, const wc_collider *col)
 {
@@ -61,8 +67,7 @@ int wc_near_list_holds(const wc_near_list *l, const wc_cloth *c, const wc_collid
     for (int32_t k = 0; k < count; ++k) {
         int32_t i = only ? only[k] : k;
         const double *box = l->particle_boxes + 6 * (size_t)i;
-        if (!inside(box, c->x[i], c->y[i], c->z[i]) || !inside(box, c->nx[i], c->ny[i], c->nz[i]))
-            return 0;
+        if (!motion_inside(box, c, i)) return 0;
     }
     return 1;
 }
@@ -84,32 +89,35 @@ int wc_near_list_particle(const wc_near_list *l, const wc_collider *col, double 
     return 1;
 }
 
-/* Grows an int32 array to hold `need` items; 0 on out-of-memory. */
-static int reserve(int32_t **array, int64_t *capacity, int64_t need)
+/* Grows *array (items of `size` bytes, contents kept) to hold `need`
+ * items; 0 on out-of-memory, with *array as it was. */
+static int grow(void **array, int64_t *capacity, int64_t need, size_t size)
 {
     if (need <= *capacity) return 1;
     int64_t grown = *capacity ? *capacity : 64;
     while (grown < need) grown *= 2;
-    int32_t *bigger = wc_alloc_array((size_t)grown, sizeof *bigger);
+    void *bigger = wc_alloc_array((size_t)grown, size);
     if (!bigger) return 0;
-    if (*capacity) memcpy(bigger, *array, (size_t)*capacity * sizeof *bigger);
+    if (*capacity) memcpy(bigger, *array, (size_t)*capacity * size);
     wc_free(*array);
     *array = bigger, *capacity = grown;
     return 1;
 }
 
-/* Grows a double array to hold `need` items; 0 on out-of-memory. */
+static int reserve(int32_t **array, int64_t *capacity, int64_t need)
+{
+    void *a = *array;
+    int ok = grow(&a, capacity, need, sizeof **array);
+    *array = a;
+    return ok;
+}
+
 static int reserve_doubles(double **array, int64_t *capacity, int64_t need)
 {
-    if (need <= *capacity) return 1;
-    int64_t grown = *capacity ? *capacity : 64;
-    while (grown < need) grown *= 2;
-    double *bigger = wc_alloc_array((size_t)grown, sizeof *bigger);
-    if (!bigger) return 0;
-    if (*capacity) memcpy(bigger, *array, (size_t)*capacity * sizeof *bigger);
-    wc_free(*array);
-    *array = bigger, *capacity = grown;
-    return 1;
+    void *a = *array;
+    int ok = grow(&a, capacity, need, sizeof **array);
+    *array = a;
+    return ok;
 }
 
 /* Particle p of element e: elements of `per` particles each, or with
@@ -258,8 +266,7 @@ wc_status wc_near_list_build(wc_near_list *l, const wc_cloth *c, const int32_t *
     double margin = MARGIN_CELLS * col->vertex_grid.cell_size;
     for (int32_t i = 0; i < n; ++i) {
         double *box = l->particle_boxes + 6 * (size_t)i;
-        l->left[i] = !keep || !inside(box, c->x[i], c->y[i], c->z[i]) ||
-                     !inside(box, c->nx[i], c->ny[i], c->nz[i]);
+        l->left[i] = !keep || !motion_inside(box, c, i);
         if (!l->left[i]) continue;
         double start[3] = {c->x[i], c->y[i], c->z[i]}, end[3] = {c->nx[i], c->ny[i], c->nz[i]};
         for (int k = 0; k < 3; ++k) {
