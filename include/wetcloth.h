@@ -602,6 +602,10 @@ typedef struct wc_step_stats {
     double integrate_seconds;
     double collide_seconds;
     double wet_seconds;
+    /// Iterations of the implicit integrator's linear solver (preconditioned
+    /// conjugate gradients), summed over the cloths and, for
+    /// wc_world_advance, over its substeps. 0 for Verlet and XPBD.
+    int64_t solver_iterations;
 } wc_step_stats;
 
 /// Statistics of the last step.

@@ -240,6 +240,7 @@ static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_f
     case WC_INTEGRATOR_IMPLICIT:
         if (!cl->implicit && !(cl->implicit = wc_implicit_state_create(cl))) break;
         bad = wc_integrate_implicit(cl, dt, pin_fraction, threads);
+        w->solver_iterations += wc_implicit_last_iterations(cl->implicit);
         return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
     default:
         bad = wc_integrate_verlet(cl, dt, pin_fraction, threads);
@@ -310,7 +311,11 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_fra
 }
 
 /* Before a step or an advance: no phase time yet. */
-static void start_timing(wc_world *w) { memset(w->phase_seconds, 0, sizeof w->phase_seconds); }
+static void start_timing(wc_world *w)
+{
+    memset(w->phase_seconds, 0, sizeof w->phase_seconds);
+    w->solver_iterations = 0;
+}
 
 /* After it: the phase times of all its steps into the stats. */
 static void finish_timing(wc_world *w)
@@ -319,6 +324,7 @@ static void finish_timing(wc_world *w)
     w->stats.integrate_seconds = w->phase_seconds[1];
     w->stats.collide_seconds = w->phase_seconds[2];
     w->stats.wet_seconds = w->phase_seconds[3];
+    w->stats.solver_iterations = w->solver_iterations;
 }
 
 /* After an advance, pins start the next one from where they are. A

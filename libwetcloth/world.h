@@ -21,6 +21,8 @@ struct wc_world {
     /// stats of each substep are cleared, these are not): forces,
     /// integration, collisions, wet response and commit.
     double phase_seconds[4];
+    /// Linear-solver iterations since start_timing (world.c).
+    int64_t solver_iterations;
     /// Message of the last failed call. Calls that take a const world still
     /// report here: the world itself is never const-defined (it comes from
     /// wc_world_create), so writing through a cast pointer is well defined.

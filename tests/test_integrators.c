@@ -487,8 +487,63 @@ static void bad_integrator(void)
     CHECK(strstr(msg.text, "world_def.integrator") != NULL, "message: %s", msg.text);
 }
 
+/* ------------------------------------------------------------------------ */
+/* The linear solver's iteration count in the stats                         */
+/* ------------------------------------------------------------------------ */
+
+/* wc_step_stats.solver_iterations: 0 for the integrators without a linear
+ * solve; for the implicit one, each step's count is in [1, 1000] (the rhs
+ * is never zero under gravity; 1000 is the solver's cap), and an advance
+ * of 4 substeps reports exactly the sum of what 4 single steps of the same
+ * length report (the substeps of an advance are those steps, bit for bit,
+ * for a scene without pins or moving colliders). */
+static wc_world *iterations_world(wc_integrator integrator)
+{
+    wc_world *w = make_world(integrator, (double[3]){0.0, 0.0, -9.81}, 1);
+    scene_add_thesis_sphere(w, 0.3);
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = DRAPE_N;
+    g.center[2] = 0.35;
+    scene_add_grid(w, &g);
+    return w;
+}
+
+static void solver_iterations(void)
+{
+    for (int which = 0; which < 2; ++which) {
+        wc_world *w = iterations_world(ALL[which]);
+        CHECK(wc_world_advance(w, 1.0 / 24, 0) == WC_OK, "%s: %s", NAME[which],
+              wc_world_last_error(w));
+        CHECK(wc_world_get_stats(w).solver_iterations == 0, "%s: %lld iterations", NAME[which],
+              (long long)wc_world_get_stats(w).solver_iterations);
+        wc_world_destroy(w);
+    }
+    wc_world *advanced = iterations_world(WC_INTEGRATOR_IMPLICIT);
+    wc_world *stepped = iterations_world(WC_INTEGRATOR_IMPLICIT);
+    for (int frame = 0; frame < 6; ++frame) {
+        CHECK(wc_world_advance(advanced, 1.0 / 24, 4) == WC_OK, "%s",
+              wc_world_last_error(advanced));
+        int64_t sum = 0;
+        for (int k = 0; k < 4; ++k) {
+            CHECK(wc_world_step(stepped, 1.0 / 96) == WC_OK, "%s", wc_world_last_error(stepped));
+            int64_t one = wc_world_get_stats(stepped).solver_iterations;
+            CHECK(one >= 1 && one <= 1000, "frame %d step %d: %lld iterations", frame, k,
+                  (long long)one);
+            sum += one;
+        }
+        int64_t total = wc_world_get_stats(advanced).solver_iterations;
+        CHECK(total == sum, "frame %d: the advance reports %lld iterations, its steps %lld", frame,
+              (long long)total, (long long)sum);
+        if (frame == 5) printf("implicit solver iterations, last frame of 4 steps: %lld\n",
+                               (long long)total);
+    }
+    wc_world_destroy(advanced);
+    wc_world_destroy(stepped);
+}
+
 int main(void)
 {
+    solver_iterations();
     bad_integrator();
     stable_steps();
     for (int which = 0; which < 3; ++which) free_fall(which);

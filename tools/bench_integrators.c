@@ -58,6 +58,7 @@ typedef struct run_result {
     double ms_per_frame;
     double cpu_ms_per_frame; /* process CPU time: less sensitive to a shared machine */
     double phase_ms[3]; /* forces, integration, collisions; per frame */
+    double solver_iterations; /* implicit: CG iterations per substep */
     double *positions;  /* frames x 3 n, caller frees */
     int32_t n;
 } run_result;
@@ -118,12 +119,14 @@ static run_result run(const options *o, int size, int self, int integrator, int 
         r.phase_ms[0] += 1e3 * st.force_seconds;
         r.phase_ms[1] += 1e3 * st.integrate_seconds;
         r.phase_ms[2] += 1e3 * st.collide_seconds;
+        r.solver_iterations += (double)st.solver_iterations;
         wc_cloth_get_positions(w, cl, r.positions + (size_t)f * 3 * (size_t)r.n, r.n);
     }
     r.substeps = wc_world_last_substeps(w);
     r.ms_per_frame = 1e3 * wall / r.frames;
     r.cpu_ms_per_frame = 1e3 * cpu / r.frames;
     for (int k = 0; k < 3; ++k) r.phase_ms[k] /= r.frames;
+    r.solver_iterations /= (double)r.frames * r.substeps;
     wc_world_destroy(w);
     return r;
 }
@@ -166,6 +169,7 @@ static void print_row(int size, int self, int integrator, const run_result *r, d
         printf(" %9.2f", blender / r->ms_per_frame);
     else
         printf(" %9s", "-");
+    printf(" %8.1f", r->solver_iterations);
     printf("%s\n", r->failed ? "  FAILED (non-finite step)" : "");
     fflush(stdout);
 }
@@ -262,11 +266,11 @@ int main(int argc, char **argv)
            "distance over particles and frames to the same integrator at 8x the substeps, / 1 m; "
            "vs verlet: the same against Verlet at its automatic step. ms per simulated frame, "
            "its CPU time (cpu ms, all threads), the phases forces / integration / collisions (wall). x blender: Blender's ms per frame "
-           "(NOTES) / ours.\n\n",
+           "(NOTES) / ours. cg/step: the implicit integrator's conjugate-gradient iterations per substep.\n\n",
            o.seconds, (int)lround(o.seconds * 24), o.threads);
-    printf("%-9s %-4s %-9s %8s %10s %8s %7s %7s %7s %10s %10s %9s\n", "particles", "self",
+    printf("%-9s %-4s %-9s %8s %10s %8s %7s %7s %7s %10s %10s %9s %8s\n", "particles", "self",
            "integr.", "steps/fr", "ms/frame", "cpu ms", "force", "integr", "collide", "error", "vs verlet",
-           "x blender");
+           "x blender", "cg/step");
     char summary[MAX_LIST * MAX_LIST * 3][200];
     int lines = 0;
     for (int s = 0; s < o.size_count; ++s)

@@ -411,8 +411,20 @@ def test_stats_keys():
         s = w.stats
         assert set(s) == {"steps", "time", "last_substeps", "collider_contacts",
                           "cloth_contacts", "failsafe_particles", "stuck_particles",
-                          "step_seconds", "phase_seconds"}
+                          "step_seconds", "phase_seconds", "solver_iterations"}
         assert s["steps"] == s["last_substeps"] > 0 and s["step_seconds"] > 0
+        assert s["solver_iterations"] == 0  # Verlet solves no linear system
+
+
+def test_solver_iterations_of_the_implicit_integrator():
+    """The implicit integrator reports its conjugate-gradient iterations:
+    at least one per substep of the advance, at most the solver's cap of
+    1000 per substep."""
+    with World(integrator="implicit") as w:
+        w.add_grid_cloth(10, 10)
+        w.advance(1 / 24, substeps=3)
+        s = w.stats
+        assert 3 <= s["solver_iterations"] <= 3000
 
 
 def test_phase_seconds_split_the_step_time():

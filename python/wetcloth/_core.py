@@ -486,7 +486,9 @@ class World:
         cloth_contacts, failsafe_particles, stuck_particles; step_seconds is
         the wall time spent inside step() and advance(); phase_seconds is the
         library's wall time by phase (forces, integrate, collide, wet) of the
-        last step(), or of all substeps of the last advance()."""
+        last step(), or of all substeps of the last advance(); and
+        solver_iterations, the implicit integrator's conjugate-gradient
+        iterations over the same steps (0 for the other integrators)."""
         h = self._handle()
         s = lib.wc_world_get_stats(h)
         return {
@@ -504,6 +506,7 @@ class World:
                 "collide": float(s.collide_seconds),
                 "wet": float(s.wet_seconds),
             },
+            "solver_iterations": int(s.solver_iterations),
         }
 
 
