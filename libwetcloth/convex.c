@@ -457,6 +457,21 @@ static void ball_probe(probe_obj *p, const double c[3], double r)
     memcpy(p->center, c, sizeof p->center);
 }
 
+/* What libccd's penetration call (status rc) gave: 1 with depth and unit
+ * direction when it found a contact within the shape's support budget, 0
+ * otherwise. A touching contact (depth 0) comes without a direction, and
+ * a direction much shorter than unit means libccd had none to give. */
+static int penetration_found(int rc, const shape_obj *so, ccd_real_t d, const ccd_vec3_t *v,
+                             double *depth, double dir[3])
+{
+    if (rc != 0 || so->calls > so->budget) return 0;
+    double len = sqrt(v->v[0] * v->v[0] + v->v[1] * v->v[1] + v->v[2] * v->v[2]);
+    if (!isfinite(d) || !(d > 0.0) || !(len > 0.5)) return 0;
+    *depth = d;
+    for (int k = 0; k < 3; ++k) dir[k] = v->v[k] / len;
+    return 1;
+}
+
 /* One MPR call: ball (c, r) against the whole shape, from its interior
  * point. Returns 1 with depth and direction on contact, 0 otherwise
  * (including a call that ran out of budget or produced something
@@ -474,13 +489,7 @@ static int mpr_ball(const wc_convex_shape *s, const double c[3], double r, doubl
     ccd_real_t d = 0.0;
     ccd_vec3_t v, pos;
     int rc = ccdMPRPenetration(&ball, &so, &ccd, &d, &v, &pos);
-    if (rc != 0 || so.calls > so.budget) return 0;
-    double len = sqrt(v.v[0] * v.v[0] + v.v[1] * v.v[1] + v.v[2] * v.v[2]);
-    /* a touching contact (depth 0) comes without a direction */
-    if (!isfinite(d) || !(d > 0.0) || !(len > 0.5)) return 0;
-    *depth = d;
-    for (int k = 0; k < 3; ++k) dir[k] = v.v[k] / len;
-    return 1;
+    return penetration_found(rc, &so, d, &v, depth, dir);
 }
 
 /* Penetration of the point c into a box or hull that holds it, from
@@ -499,12 +508,7 @@ static int epa_point(const wc_convex_shape *s, const double c[3], double scale, 
     ccd_real_t d = 0.0;
     ccd_vec3_t v, pos;
     int rc = ccdGJKPenetration(&pt, &so, &ccd, &d, &v, &pos);
-    if (rc != 0 || so.calls > so.budget) return 0;
-    double len = sqrt(v.v[0] * v.v[0] + v.v[1] * v.v[1] + v.v[2] * v.v[2]);
-    if (!isfinite(d) || !(d > 0.0) || !(len > 0.5)) return 0;
-    *depth = d;
-    for (int k = 0; k < 3; ++k) dir[k] = v.v[k] / len;
-    return 1;
+    return penetration_found(rc, &so, d, &v, depth, dir);
 }
 
 /* ---- Closest point of the shape's core to a point (GJK) ----
