@@ -99,6 +99,19 @@ class _BakeOperator:
     def invoke(self, context, event):
         if bpy.app.background or context.window is None:
             return self.execute(context)
+        result = self._begin_modal(context)
+        if result != {"RUNNING_MODAL"}:
+            return result
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.01, window=context.window)
+        wm.modal_handler_add(self)
+        return result
+
+    def _begin_modal(self, context):
+        """Starts the bake that modal() then steps: {"RUNNING_MODAL"}, or
+        {"CANCELLED"} after reporting why not. Apart from the timer and the
+        modal handler, which need a window, this is all of the interactive
+        start (the tests drive modal() from here headless)."""
         baker = self._prepare(context)
         if baker is None:
             return {"CANCELLED"}
@@ -108,10 +121,7 @@ class _BakeOperator:
             return self._failed(baker, e)
         self._baker = baker
         _running.update(o.name for o in baker.objects)
-        wm = context.window_manager
-        wm.progress_begin(0, baker.frame_count)
-        self._timer = wm.event_timer_add(0.01, window=context.window)
-        wm.modal_handler_add(self)
+        context.window_manager.progress_begin(0, baker.frame_count)
         self._status(context)
         return {"RUNNING_MODAL"}
 
@@ -119,7 +129,7 @@ class _BakeOperator:
         b = self._baker
         text = "Wet Cloth: baking %s, frame %d of %d (Esc to cancel)" % (
             _names(b.objects), b.progress, b.frame_count)
-        if context.workspace is not None:
+        if context.workspace is not None and context.window is not None:
             context.workspace.status_text_set(text)
 
     def _end(self, context):
@@ -128,7 +138,7 @@ class _BakeOperator:
             wm.event_timer_remove(self._timer)
             self._timer = None
         wm.progress_end()
-        if context.workspace is not None:
+        if context.workspace is not None and context.window is not None:
             context.workspace.status_text_set(None)
         _running.difference_update(o.name for o in self._baker.objects)
 

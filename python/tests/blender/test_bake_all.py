@@ -185,3 +185,90 @@ def test_bake_all_errors_and_failures_keep_previous(empty_scene, cache_dir):
     for ob in (lower, upper):
         assert "Wet Cloth Cache" not in ob.modifiers
         assert "wet_cloth_wetness" not in ob.data.attributes
+
+
+# ---------------------------------------------------------------------------
+# the interactive (modal) bake: Esc cancels and keeps the previous bakes
+
+
+class _Event:
+    def __init__(self, kind):
+        self.type = kind
+
+
+def modal_driver():
+    """Bake All's interactive path, driven by hand. Headless Blender has no
+    window: invoke() runs execute() there, and nothing would send a modal
+    handler its events. So the test starts the bake as invoke() does in the
+    UI (_begin_modal: all of it but the timer and the handler, which need a
+    window) and sends modal() the TIMER and ESC events itself. The driver
+    is the operator's own class minus Blender's operator machinery; its
+    reports are kept in .reports."""
+    from bl_ext.user_default.wetcloth import ops
+
+    class Driver(ops._BakeOperator):
+        _objects = ops.WETCLOTH_OT_bake_all._objects
+
+        def __init__(self):
+            self.reports = []
+
+        def report(self, level, text):
+            self.reports.append((set(level), text))
+
+    return Driver(), ops
+
+
+def caches(objects):
+    out = {}
+    for ob in objects:
+        with open(cache_path(ob), "rb") as f:
+            out[ob.name] = f.read()
+    return out
+
+
+def test_escape_cancels_a_modal_bake_and_keeps_the_previous(empty_scene, cache_dir):
+    _sphere, lower, upper = two_cloths(cache_dir)
+    # long enough that one TIMER event (0.1 s of stepping) cannot finish it
+    empty_scene.frame_end = 240
+    assert bake_all() == {"FINISHED"}
+    before = caches((lower, upper))
+    upper.wet_cloth.wetness = 0.0  # a new bake would differ
+    empty_scene.frame_set(3)
+    driver, ops = modal_driver()
+    ctx = bpy.context
+    assert driver._begin_modal(ctx) == {"RUNNING_MODAL"}
+    assert ops._running == {"Lower", "Upper"}
+    assert driver.modal(ctx, _Event("MOUSEMOVE")) == {"PASS_THROUGH"}
+    assert driver.modal(ctx, _Event("TIMER")) == {"RUNNING_MODAL"}
+    baker = driver._baker
+    assert 0 < baker.progress < baker.frame_count
+    # a second bake of the same objects is refused while this one runs
+    second, _ = modal_driver()
+    assert second._begin_modal(ctx) == {"CANCELLED"}
+    assert "being baked already" in second.reports[-1][1]
+    assert driver.modal(ctx, _Event("ESC")) == {"CANCELLED"}
+    level, text = driver.reports[-1]
+    assert level == {"WARNING"} and "cancelled" in text and "previous bake is kept" in text
+    assert ops._running == set()
+    assert caches((lower, upper)) == before
+    assert sorted(os.listdir(os.path.dirname(cache_path(lower)))) == ["Lower.pc2", "Upper.pc2"]
+    assert empty_scene.frame_current == 3
+    print("modal bake cancelled at frame %d of %d" % (baker.progress, baker.frame_count))
+
+
+def test_a_modal_bake_to_the_end_is_the_synchronous_one(empty_scene, cache_dir):
+    _sphere, lower, upper = two_cloths(cache_dir)
+    assert bake_all() == {"FINISHED"}
+    synchronous = caches((lower, upper))
+    bpy.ops.wetcloth.free_bake_all()
+    driver, ops = modal_driver()
+    ctx = bpy.context
+    assert driver._begin_modal(ctx) == {"RUNNING_MODAL"}
+    result, events = {"RUNNING_MODAL"}, 0
+    while result == {"RUNNING_MODAL"} and events < 10000:
+        result = driver.modal(ctx, _Event("TIMER"))
+        events += 1
+    assert result == {"FINISHED"}, driver.reports
+    assert driver.reports[-1][0] == {"INFO"} and "baked" in driver.reports[-1][1]
+    assert ops._running == set()
+    assert caches((lower, upper)) == synchronous
