@@ -6,7 +6,9 @@
 #include "alloc.h"
 #include "buckling.h"
 #include "integrate.h"
+#include "multigrid.h"
 #include "parallel.h"
+#include "primitives.h"
 
 /* The solve stops when |r| <= CG_TOLERANCE |b|. The right-hand side is the
  * step's momentum change h f; 1e-8 of it leaves velocity errors far below
@@ -36,6 +38,9 @@ struct wc_implicit_state {
     /// search direction, matrix times direction.
     double *v0, *fixed, *rhs, *y, *r, *z, *p, *q;
     double *partial;
+    /// The preconditioner's coarse levels; NULL for a cloth too small to
+    /// gain from them (multigrid.h).
+    wc_multigrid *multigrid;
     int32_t last_iterations;
     double last_residual;
 };
@@ -48,6 +53,7 @@ void wc_implicit_state_destroy(wc_implicit_state *s)
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
     wc_free(s->end_a);
     wc_free(s->end_b);
+    wc_multigrid_destroy(s->multigrid);
     wc_free(s);
 }
 
@@ -79,6 +85,11 @@ wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
     for (int32_t e = 0; e < st->count; ++e) s->end_a[e] = st->a[e], s->end_b[e] = st->b[e];
     for (int32_t e = 0; e < bd->count; ++e)
         s->end_a[st->count + e] = bd->a[e], s->end_b[st->count + e] = bd->b[e];
+    if (wc_multigrid_create(s->n, s->links, s->end_a, s->end_b, st->count, c->link_start,
+                            c->link_list, &s->multigrid)) {
+        wc_implicit_state_destroy(s);
+        return NULL;
+    }
     return s;
 }
 
@@ -205,21 +216,6 @@ static int start_velocities_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-/* Inverse of a symmetric 3 x 3 block (xx, xy, xz, yy, yz, zz); the block
- * is positive definite (mass plus positive semi-definite link blocks). */
-static void invert_block(const double *m, double *out)
-{
-    double c0 = m[3] * m[5] - m[4] * m[4], c1 = m[2] * m[4] - m[1] * m[5],
-           c2 = m[1] * m[4] - m[2] * m[3];
-    double inv_det = 1.0 / (m[0] * c0 + m[1] * c1 + m[2] * c2);
-    out[0] = c0 * inv_det;
-    out[1] = c1 * inv_det;
-    out[2] = c2 * inv_det;
-    out[3] = (m[0] * m[5] - m[2] * m[2]) * inv_det;
-    out[4] = (m[1] * m[2] - m[0] * m[4]) * inv_det;
-    out[5] = (m[0] * m[3] - m[1] * m[1]) * inv_det;
-}
-
 /* Per free particle, gathered over its links in their fixed order: the
  * right-hand side h f_i + h^2 (df/dx v0)_i plus what the pins' known dv
  * contribute, and the preconditioner (the inverse diagonal block). Pinned
@@ -256,7 +252,7 @@ static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t en
             }
         }
         b[0] = bx, b[1] = by, b[2] = bz;
-        invert_block(diag, pre);
+        wc_sym3_inverse(diag, pre);
     }
     return 0;
 }
@@ -310,6 +306,15 @@ static void particle_pass(implicit_pass *pass, wc_range_fn body, const double *i
     int32_t n = pass->state->n;
     pass->in = in, pass->out = out;
     wc_parallel_for(n, wc_threads_for(n, threads), body, pass);
+}
+
+/* z = the preconditioner applied to r: block-Jacobi, plus the coarse
+ * levels' correction on a large cloth. */
+static void precondition(implicit_pass *pass, int threads)
+{
+    wc_implicit_state *s = pass->state;
+    particle_pass(pass, precondition_range, s->r, s->z, threads);
+    if (s->multigrid) wc_multigrid_add_correction(s->multigrid, s->r, s->z, threads);
 }
 
 /* a . b over 3n values, summed in fixed chunks, then the chunks in order. */
@@ -378,7 +383,7 @@ static void solve(implicit_pass *pass, int threads)
     double bb = dot(pass, s->rhs, s->rhs, threads), rr = bb;
     int32_t it = 0;
     if (bb > 0.0) {
-        particle_pass(pass, precondition_range, s->r, s->z, threads);
+        precondition(pass, threads);
         memcpy(s->p, s->z, bytes);
         double rz = dot(pass, s->r, s->z, threads);
         for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
@@ -390,7 +395,7 @@ static void solve(implicit_pass *pass, int threads)
             double alpha = rz / pq;
             vector_update(pass, update_solution_range, alpha, threads);
             rr = dot(pass, s->r, s->r, threads);
-            particle_pass(pass, precondition_range, s->r, s->z, threads);
+            precondition(pass, threads);
             double rz_next = dot(pass, s->r, s->z, threads);
             vector_update(pass, update_direction_range, rz_next / rz, threads);
             rz = rz_next;
@@ -452,6 +457,8 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, int t
     wc_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);
     int32_t bad = first_non_finite_rhs(s);
     if (bad >= 0) return bad;
+    if (s->multigrid)
+        wc_multigrid_update(s->multigrid, s->mass_diag, s->block, c->pin_slot, threads);
     solve(&pass, threads);
     positions_pass positions = {c, s, dt, pin_fraction};
     wc_parallel_for(n, particle_threads, positions_range, &positions);

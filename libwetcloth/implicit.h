@@ -4,7 +4,8 @@
  * with df/dx the stretch links' Jacobian (tension only) and the bend
  * links' axial stiffness (their transverse term dropped, as Choi & Ko do,
  * because it would make the matrix indefinite), df/dv the stretch dashpots
- * and air drag. Block-Jacobi preconditioned conjugate gradients, matrix-free,
+ * and air drag. Block-Jacobi preconditioned conjugate gradients (with coarse
+ * levels on large cloths, multigrid.h), matrix-free,
  * gathered per particle with fixed-order reductions: the same bits for any
  * thread count. */
 #ifndef WC_IMPLICIT_H

@@ -242,3 +242,21 @@ int wc_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
     }
     return 0;
 }
+
+void wc_sym3_inverse(const double m[6], double out[6])
+{
+    double c0 = m[3] * m[5] - m[4] * m[4], c1 = m[2] * m[4] - m[1] * m[5],
+           c2 = m[1] * m[4] - m[2] * m[3];
+    double det = m[0] * c0 + m[1] * c1 + m[2] * c2;
+    if (!(det > 0.0) || !(m[0] > 0.0)) {
+        for (int k = 0; k < 6; ++k) out[k] = 0.0;
+        return;
+    }
+    double inv_det = 1.0 / det;
+    out[0] = c0 * inv_det;
+    out[1] = c1 * inv_det;
+    out[2] = c2 * inv_det;
+    out[3] = (m[0] * m[5] - m[2] * m[2]) * inv_det;
+    out[4] = (m[1] * m[2] - m[0] * m[4]) * inv_det;
+    out[5] = (m[0] * m[3] - m[1] * m[1]) * inv_det;
+}

@@ -18,6 +18,13 @@ static inline double wc_lerp(double a, double b, double t)
     return isfinite(d) ? a + d * t : a * (1.0 - t) + b * t;
 }
 
+/// Inverse of a symmetric 3 x 3 matrix given as xx, xy, xz, yy, yz, zz,
+/// into the same layout, by cofactors. A matrix that is not positive
+/// definite (determinant or xx not > 0, NaN included) gets zeros: the
+/// preconditioners that use it (implicit.c, multigrid.c) invert blocks that
+/// are positive definite, or empty ones, whose rows must stay zero.
+void wc_sym3_inverse(const double m[6], double out[6]);
+
 /// Closest point of triangle (a, b, c) to p. Returns the squared distance and
 /// writes the barycentric coordinates (weights of a, b, c) of the closest point.
 double wc_point_triangle_closest(const double p[3], const double a[3], const double b[3],

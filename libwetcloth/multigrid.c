@@ -1,0 +1,518 @@
+#include "multigrid.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "parallel.h"
+#include "primitives.h"
+
+/* Coarsening stops at this many nodes: the coarsest level's sweeps then
+ * reach across it. */
+#define COARSEST_NODES 32
+/* ... or when a level would keep more than this share of its nodes:
+ * aggregates that small would not pay for the level. */
+#define LEAST_REDUCTION 0.75
+#define MAX_LEVELS 16
+/* Damped block-Jacobi: D_full (D plus the link blocks at a node) satisfies
+ * A <= 2 D_full, so with this weight the sweep's eigenvalues lie in
+ * (-1/3, 1): convergent, and it damps the high frequencies of a
+ * Laplacian-like matrix best. */
+#define SMOOTHING_WEIGHT (2.0 / 3.0)
+#define COARSEST_SWEEPS 4
+
+typedef struct level {
+    int32_t n, links;
+    /* structure: borrowed at the finest level, owned above (own_ints) */
+    const int32_t *end_a, *end_b, *adj_start, *adj;
+    int32_t *own_ints[4];
+    /* values: at the finest level the mass (one number per node), the link
+     * blocks and the pins, all borrowed; above, D, B and the inverse of
+     * D_full, 6 numbers per node or link */
+    const double *mass, *block;
+    const int32_t *pin_slot;
+    double *diag, *own_block, *inv;
+    /* toward the next coarser level: each node's aggregate, each
+     * aggregate's nodes (CSR), each coarse link's fine links (CSR) */
+    int32_t *agg, *member_start, *members, *fine_start, *fine_links;
+    /* cycle vectors, 3 per node (coarse levels): solution, right-hand
+     * side, residual */
+    double *x, *b, *r;
+} level;
+
+struct wc_multigrid {
+    int32_t levels;
+    level level[MAX_LEVELS];
+};
+
+static void level_free(level *l)
+{
+    for (int k = 0; k < 4; ++k) wc_free(l->own_ints[k]);
+    int32_t *ints[] = {l->agg, l->member_start, l->members, l->fine_start, l->fine_links};
+    for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) wc_free(ints[k]);
+    double *doubles[] = {l->diag, l->own_block, l->inv, l->x, l->b, l->r};
+    for (size_t k = 0; k < sizeof doubles / sizeof doubles[0]; ++k) wc_free(doubles[k]);
+}
+
+void wc_multigrid_destroy(wc_multigrid *mg)
+{
+    if (!mg) return;
+    for (int32_t k = 0; k < mg->levels; ++k) level_free(&mg->level[k]);
+    wc_free(mg);
+}
+
+int32_t wc_multigrid_levels(const wc_multigrid *mg) { return mg->levels; }
+
+/* ------------------------------------------------------------------------ */
+/* Structure, once per cloth                                                */
+/* ------------------------------------------------------------------------ */
+
+static int32_t link_of(int32_t entry) { return entry >= 0 ? entry : ~entry; }
+
+/* The node at the other end of an adjacency entry. */
+static int32_t other_end(const level *l, int32_t entry)
+{
+    return entry >= 0 ? l->end_b[entry] : l->end_a[~entry];
+}
+
+/* Whether adjacency entry k of node i joins a neighbour for aggregation. */
+static int neighbour_entry(const level *l, int32_t k, int32_t neighbour_links)
+{
+    return link_of(l->adj[k]) < neighbour_links;
+}
+
+/* Greedy aggregation in index order (Vanek, Mandel & Brezina 1996): a node
+ * whose neighbours are all unassigned starts an aggregate with them; every
+ * other node joins the aggregate of its first neighbour assigned in that
+ * first pass; a node with none left starts one of its own. Returns the
+ * number of aggregates. */
+static int32_t aggregate(const level *l, int32_t neighbour_links, int32_t *agg)
+{
+    int32_t n = l->n, count = 0;
+    for (int32_t i = 0; i < n; ++i) agg[i] = -1;
+    for (int32_t i = 0; i < n; ++i) {
+        int ready = 1;
+        for (int32_t k = l->adj_start[i]; ready && k < l->adj_start[i + 1]; ++k)
+            if (neighbour_entry(l, k, neighbour_links)) ready = agg[other_end(l, l->adj[k])] < 0;
+        if (!ready || agg[i] >= 0) continue;
+        agg[i] = count;
+        for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k)
+            if (neighbour_entry(l, k, neighbour_links)) agg[other_end(l, l->adj[k])] = count;
+        ++count;
+    }
+    /* joined in a second pass, marked -2 - aggregate meanwhile so that no
+     * node joins through a node that joined in this same pass */
+    for (int32_t i = 0; i < n; ++i) {
+        if (agg[i] != -1) continue;
+        for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k) {
+            int32_t j = other_end(l, l->adj[k]);
+            if (neighbour_entry(l, k, neighbour_links) && agg[j] >= 0) {
+                agg[i] = -2 - agg[j];
+                break;
+            }
+        }
+    }
+    for (int32_t i = 0; i < n; ++i)
+        if (agg[i] <= -2) agg[i] = -2 - agg[i];
+    for (int32_t i = 0; i < n; ++i)
+        if (agg[i] < 0) agg[i] = count++;
+    return count;
+}
+
+/* Each aggregate's nodes, ascending (a counting sort). */
+static int build_members(level *f, int32_t nc)
+{
+    f->member_start = wc_alloc_array((size_t)nc + 1, sizeof(int32_t));
+    f->members = wc_alloc_array((size_t)f->n, sizeof(int32_t));
+    int32_t *fill = wc_alloc_array((size_t)nc, sizeof(int32_t));
+    int failed = !f->member_start || !f->members || !fill;
+    if (!failed) {
+        for (int32_t i = 0; i < f->n; ++i) ++f->member_start[f->agg[i] + 1];
+        for (int32_t a = 0; a < nc; ++a) f->member_start[a + 1] += f->member_start[a];
+        for (int32_t i = 0; i < f->n; ++i)
+            f->members[f->member_start[f->agg[i]] + fill[f->agg[i]]++] = i;
+    }
+    wc_free(fill);
+    return failed;
+}
+
+/* A fine link between two aggregates, sorted by the pair and then by the
+ * fine link: that order fixes the coarse links and the order of each one's
+ * sum. */
+typedef struct cross_link {
+    int32_t lo, hi, fine;
+} cross_link;
+
+static int compare_cross(const void *pa, const void *pb)
+{
+    const cross_link *a = pa, *b = pb;
+    if (a->lo != b->lo) return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi) return a->hi < b->hi ? -1 : 1;
+    return (a->fine > b->fine) - (a->fine < b->fine);
+}
+
+/* The fine links between different aggregates, sorted. NULL when out of
+ * memory. */
+static cross_link *sorted_cross_links(const level *f, int32_t *count)
+{
+    int32_t m = 0;
+    for (int32_t e = 0; e < f->links; ++e) m += f->agg[f->end_a[e]] != f->agg[f->end_b[e]];
+    cross_link *cross = wc_alloc_array((size_t)m + 1, sizeof *cross);
+    if (!cross) return NULL;
+    m = 0;
+    for (int32_t e = 0; e < f->links; ++e) {
+        int32_t a = f->agg[f->end_a[e]], b = f->agg[f->end_b[e]];
+        if (a == b) continue;
+        cross[m].lo = a < b ? a : b, cross[m].hi = a < b ? b : a, cross[m].fine = e;
+        ++m;
+    }
+    qsort(cross, (size_t)m, sizeof *cross, compare_cross);
+    *count = m;
+    return cross;
+}
+
+static int new_pair(const cross_link *cross, int32_t k)
+{
+    return k == 0 || cross[k].lo != cross[k - 1].lo || cross[k].hi != cross[k - 1].hi;
+}
+
+/* The coarse level's links: one per pair of aggregates that fine links
+ * join, with those fine links (f->fine_start, f->fine_links). */
+static int build_coarse_links(level *f, level *c)
+{
+    int32_t m = 0, links = 0;
+    cross_link *cross = sorted_cross_links(f, &m);
+    if (!cross) return 1;
+    for (int32_t k = 0; k < m; ++k) links += new_pair(cross, k);
+    int32_t *end_a = c->own_ints[0] = wc_alloc_array((size_t)links + 1, sizeof(int32_t));
+    int32_t *end_b = c->own_ints[1] = wc_alloc_array((size_t)links + 1, sizeof(int32_t));
+    f->fine_start = wc_alloc_array((size_t)links + 1, sizeof(int32_t));
+    f->fine_links = wc_alloc_array((size_t)m + 1, sizeof(int32_t));
+    int failed = !end_a || !end_b || !f->fine_start || !f->fine_links;
+    if (!failed) {
+        int32_t e = -1;
+        for (int32_t k = 0; k < m; ++k) {
+            if (new_pair(cross, k)) {
+                ++e;
+                end_a[e] = cross[k].lo, end_b[e] = cross[k].hi, f->fine_start[e] = k;
+            }
+            f->fine_links[k] = cross[k].fine;
+        }
+        f->fine_start[links] = m;
+        c->links = links, c->end_a = end_a, c->end_b = end_b;
+    }
+    wc_free(cross);
+    return failed;
+}
+
+/* The coarse level's adjacency, in the fine form: ascending links, k for
+ * the first end, ~k for the second. */
+static int build_coarse_adjacency(level *c)
+{
+    int32_t *start = c->own_ints[2] = wc_alloc_array((size_t)c->n + 1, sizeof(int32_t));
+    int32_t *adj = c->own_ints[3] = wc_alloc_array(2 * (size_t)c->links + 1, sizeof(int32_t));
+    int32_t *fill = wc_alloc_array((size_t)c->n + 1, sizeof(int32_t));
+    int failed = !start || !adj || !fill;
+    if (!failed) {
+        for (int32_t k = 0; k < c->links; ++k) ++start[c->end_a[k] + 1], ++start[c->end_b[k] + 1];
+        for (int32_t a = 0; a < c->n; ++a) start[a + 1] += start[a];
+        for (int32_t k = 0; k < c->links; ++k) {
+            adj[start[c->end_a[k]] + fill[c->end_a[k]]++] = k;
+            adj[start[c->end_b[k]] + fill[c->end_b[k]]++] = ~k;
+        }
+        c->adj_start = start, c->adj = adj;
+    }
+    wc_free(fill);
+    return failed;
+}
+
+static int allocate_values(level *c)
+{
+    size_t n = (size_t)c->n;
+    c->diag = wc_alloc_array(6 * n, sizeof(double));
+    c->inv = wc_alloc_array(6 * n, sizeof(double));
+    c->own_block = wc_alloc_array(6 * (size_t)c->links + 1, sizeof(double));
+    c->block = c->own_block;
+    c->x = wc_alloc_array(3 * n, sizeof(double));
+    c->b = wc_alloc_array(3 * n, sizeof(double));
+    c->r = wc_alloc_array(3 * n, sizeof(double));
+    return !c->diag || !c->inv || !c->own_block || !c->x || !c->b || !c->r;
+}
+
+/* Adds the level above the top one, unless the top one is small enough or
+ * would not shrink enough (*added = 0). Returns 1 when out of memory. */
+static int coarsen(wc_multigrid *mg, int32_t neighbour_links, int *added)
+{
+    level *f = &mg->level[mg->levels - 1];
+    *added = 0;
+    if (f->n <= COARSEST_NODES || mg->levels == MAX_LEVELS) return 0;
+    f->agg = wc_alloc_array((size_t)f->n, sizeof(int32_t));
+    if (!f->agg) return 1;
+    int32_t nc = aggregate(f, neighbour_links, f->agg);
+    if (nc > LEAST_REDUCTION * f->n) {
+        wc_free(f->agg);
+        f->agg = NULL;
+        return 0;
+    }
+    level *c = &mg->level[mg->levels++];
+    c->n = nc;
+    *added = 1;
+    return build_members(f, nc) || build_coarse_links(f, c) || build_coarse_adjacency(c) ||
+           allocate_values(c);
+}
+
+int wc_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const int32_t *end_b,
+                        int32_t neighbour_links, const int32_t *adj_start, const int32_t *adj,
+                        wc_multigrid **out)
+{
+    *out = NULL;
+    if (n < WC_MULTIGRID_MIN_PARTICLES) return 0;
+    wc_multigrid *mg = wc_alloc_array(1, sizeof *mg);
+    if (!mg) return 1;
+    level *fine = &mg->level[0];
+    fine->n = n, fine->links = links, fine->end_a = end_a, fine->end_b = end_b;
+    fine->adj_start = adj_start, fine->adj = adj;
+    mg->levels = 1;
+    int failed = 0, added = 1;
+    while (!failed && added) {
+        failed = coarsen(mg, neighbour_links, &added);
+        /* above the finest level every link joins neighbours */
+        neighbour_links = mg->level[mg->levels - 1].links;
+    }
+    if (failed || mg->levels == 1) {
+        wc_multigrid_destroy(mg);
+        return failed;
+    }
+    *out = mg;
+    return 0;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Values, once per step                                                    */
+/* ------------------------------------------------------------------------ */
+
+/* One loop over a level's nodes or links: its level, the coarser one, and
+ * the vectors it reads and writes. */
+typedef struct mg_pass {
+    level *fine, *coarse;
+    const double *in;
+    double *out;
+} mg_pass;
+
+static int pinned(const level *l, int32_t i) { return l->pin_slot && l->pin_slot[i] >= 0; }
+
+static void add_block(double *to, const double *b)
+{
+    for (int k = 0; k < 6; ++k) to[k] += b[k];
+}
+
+static void block_times(const double *b, const double *x, double out[3])
+{
+    out[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];
+    out[1] = b[1] * x[0] + b[3] * x[1] + b[4] * x[2];
+    out[2] = b[2] * x[0] + b[4] * x[1] + b[5] * x[2];
+}
+
+/* A coarse link's block: the sum of its fine links' blocks, those between
+ * free particles (a link to a pin acts on its free end's diagonal). */
+static int coarse_links_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    const level *f = p->fine;
+    level *c = p->coarse;
+    for (int64_t e = begin; e < end; ++e) {
+        double *b = c->own_block + 6 * (size_t)e;
+        for (int k = 0; k < 6; ++k) b[k] = 0.0;
+        for (int32_t k = f->fine_start[e]; k < f->fine_start[e + 1]; ++k) {
+            int32_t fe = f->fine_links[k];
+            if (pinned(f, f->end_a[fe]) || pinned(f, f->end_b[fe])) continue;
+            add_block(b, f->block + 6 * (size_t)fe);
+        }
+    }
+    return 0;
+}
+
+/* What a free fine node adds to its aggregate's D: its own D (at the
+ * finest level its mass, and the blocks of its links to pins). */
+static void add_member_diag(const level *f, int32_t i, double *d)
+{
+    if (!f->mass) {
+        add_block(d, f->diag + 6 * (size_t)i);
+        return;
+    }
+    d[0] += f->mass[i], d[3] += f->mass[i], d[5] += f->mass[i];
+    if (!f->pin_slot) return;
+    for (int32_t k = f->adj_start[i]; k < f->adj_start[i + 1]; ++k)
+        if (pinned(f, other_end(f, f->adj[k])))
+            add_block(d, f->block + 6 * (size_t)link_of(f->adj[k]));
+}
+
+/* An aggregate's D, and the inverse of its D_full for the smoother. */
+static int coarse_nodes_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    const level *f = p->fine;
+    level *c = p->coarse;
+    for (int64_t a = begin; a < end; ++a) {
+        double *d = c->diag + 6 * (size_t)a, whole[6];
+        for (int k = 0; k < 6; ++k) d[k] = 0.0;
+        for (int32_t m = f->member_start[a]; m < f->member_start[a + 1]; ++m)
+            if (!pinned(f, f->members[m])) add_member_diag(f, f->members[m], d);
+        memcpy(whole, d, sizeof whole);
+        for (int32_t k = c->adj_start[a]; k < c->adj_start[a + 1]; ++k)
+            add_block(whole, c->block + 6 * (size_t)link_of(c->adj[k]));
+        wc_sym3_inverse(whole, c->inv + 6 * (size_t)a);
+    }
+    return 0;
+}
+
+void wc_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
+                         const int32_t *pin_slot, int threads)
+{
+    level *fine = &mg->level[0];
+    fine->mass = mass_diag, fine->block = block, fine->pin_slot = pin_slot;
+    for (int32_t k = 0; k + 1 < mg->levels; ++k) {
+        mg_pass p = {&mg->level[k], &mg->level[k + 1], NULL, NULL};
+        int32_t links = p.coarse->links, nodes = p.coarse->n;
+        wc_parallel_for(links, wc_threads_for(links, threads), coarse_links_range, &p);
+        wc_parallel_for(nodes, wc_threads_for(nodes, threads), coarse_nodes_range, &p);
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* The correction                                                           */
+/* ------------------------------------------------------------------------ */
+
+/* r = b - A x on a coarse level. */
+static int residual_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    level *l = p->fine;
+    for (int64_t i = begin; i < end; ++i) {
+        const double *xi = l->x + 3 * (size_t)i, *b = l->b + 3 * (size_t)i;
+        double t[3], ax[3];
+        block_times(l->diag + 6 * (size_t)i, xi, ax);
+        for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k) {
+            const double *xj = l->x + 3 * (size_t)other_end(l, l->adj[k]);
+            double diff[3] = {xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]};
+            block_times(l->block + 6 * (size_t)link_of(l->adj[k]), diff, t);
+            ax[0] += t[0], ax[1] += t[1], ax[2] += t[2];
+        }
+        double *r = l->r + 3 * (size_t)i;
+        r[0] = b[0] - ax[0], r[1] = b[1] - ax[1], r[2] = b[2] - ax[2];
+    }
+    return 0;
+}
+
+/* x += w D_full^-1 r (p->in == NULL: x = w D_full^-1 b, the first sweep
+ * from zero, which needs no residual). */
+static int sweep_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    level *l = p->fine;
+    const double *res = p->in ? l->r : l->b;
+    for (int64_t i = begin; i < end; ++i) {
+        double *x = l->x + 3 * (size_t)i, t[3];
+        block_times(l->inv + 6 * (size_t)i, res + 3 * (size_t)i, t);
+        if (!p->in) x[0] = x[1] = x[2] = 0.0;
+        x[0] += SMOOTHING_WEIGHT * t[0];
+        x[1] += SMOOTHING_WEIGHT * t[1];
+        x[2] += SMOOTHING_WEIGHT * t[2];
+    }
+    return 0;
+}
+
+static void level_loop(level *l, level *c, wc_range_fn body, const double *in, double *out,
+                       int64_t count, int threads)
+{
+    mg_pass p = {l, c, in, out};
+    wc_parallel_for(count, wc_threads_for(count, threads), body, &p);
+}
+
+static void residual(level *l, int threads)
+{
+    level_loop(l, NULL, residual_range, NULL, NULL, l->n, threads);
+}
+
+/* One smoothing sweep; the first from x = 0. */
+static void smooth(level *l, int first, int threads)
+{
+    if (!first) residual(l, threads);
+    level_loop(l, NULL, sweep_range, first ? NULL : l->r, NULL, l->n, threads);
+}
+
+/* The coarse right-hand side: each aggregate sums its free members'
+ * residuals `in`. */
+static int restrict_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    const level *f = p->fine;
+    for (int64_t a = begin; a < end; ++a) {
+        double s[3] = {0.0, 0.0, 0.0};
+        for (int32_t m = f->member_start[a]; m < f->member_start[a + 1]; ++m) {
+            int32_t i = f->members[m];
+            if (pinned(f, i)) continue;
+            const double *r = p->in + 3 * (size_t)i;
+            s[0] += r[0], s[1] += r[1], s[2] += r[2];
+        }
+        memcpy(p->out + 3 * (size_t)a, s, sizeof s);
+    }
+    return 0;
+}
+
+/* out += P x_coarse: each free node takes its aggregate's correction. */
+static int prolong_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    const level *f = p->fine, *c = p->coarse;
+    for (int64_t i = begin; i < end; ++i) {
+        if (pinned(f, (int32_t)i)) continue;
+        const double *xc = c->x + 3 * (size_t)f->agg[i];
+        double *x = p->out + 3 * (size_t)i;
+        x[0] += xc[0], x[1] += xc[1], x[2] += xc[2];
+    }
+    return 0;
+}
+
+/* l->x = the V-cycle from coarse level k applied to l->b. */
+static void cycle(wc_multigrid *mg, int32_t k, int threads)
+{
+    level *l = &mg->level[k];
+    smooth(l, 1, threads);
+    if (k + 1 == mg->levels) {
+        for (int s = 1; s < COARSEST_SWEEPS; ++s) smooth(l, 0, threads);
+        return;
+    }
+    level *c = &mg->level[k + 1];
+    residual(l, threads);
+    level_loop(l, c, restrict_range, l->r, c->b, c->n, threads);
+    cycle(mg, k + 1, threads);
+    level_loop(l, c, prolong_range, NULL, l->x, l->n, threads);
+    smooth(l, 0, threads);
+}
+
+void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
+{
+    level *fine = &mg->level[0], *c = &mg->level[1];
+    level_loop(fine, c, restrict_range, r, c->b, c->n, threads);
+    cycle(mg, 1, threads);
+    level_loop(fine, c, prolong_range, NULL, z, fine->n, threads);
+}
+
+int32_t wc_multigrid_level_size(const wc_multigrid *mg, int32_t k) { return mg->level[k].n; }
+
+int32_t wc_multigrid_aggregate(const wc_multigrid *mg, int32_t k, int32_t node)
+{
+    return mg->level[k].agg[node];
+}
+
+/* With b = 0 the residual is -A x. */
+void wc_multigrid_level_product(wc_multigrid *mg, int32_t k, const double *in, double *out)
+{
+    level *l = &mg->level[k];
+    size_t len = 3 * (size_t)l->n;
+    memcpy(l->x, in, len * sizeof *in);
+    memset(l->b, 0, len * sizeof *l->b);
+    residual(l, 1);
+    for (size_t k = 0; k < len; ++k) out[k] = -l->r[k];
+}

@@ -1,0 +1,81 @@
+/* Coarse levels for the implicit integrator's preconditioner (implicit.c):
+ * a correction over coarser copies of the cloth added to block-Jacobi.
+ *
+ * Why: with block-Jacobi alone the conjugate gradients' iteration count
+ * grows with the cloth's resolution (38 per step at 20 x 20, 165 at
+ * 101 x 101 on the thesis drape at 12 steps per frame), because a correction
+ * travels about one link per iteration. The coarse levels carry it across
+ * the cloth in one application.
+ *
+ * The matrix of every level has the form
+ *   (A x)_i = D_i x_i + sum over the links e = (i, j) at i of B_e (x_i - x_j)
+ * with D_i and B_e symmetric 3 x 3 blocks; at the finest level D is the
+ * mass (with drag) and B the links' h^2 K + h C blocks. Nodes are grouped
+ * into aggregates (a node and its neighbours, greedily in index order), and
+ * a coarse matrix is the Galerkin product P^T A P with P constant over each
+ * aggregate (unsmoothed aggregation). For this form the product has the
+ * same form: an aggregate's D is the sum of its members' D (plus the blocks
+ * of their links to pinned particles, whose values are known), a coarse
+ * link's B the sum of the blocks of the fine links between its two
+ * aggregates, and links inside an aggregate cancel. So the structure is
+ * built once from the topology, and each step only sums blocks.
+ *
+ * The preconditioner is additive at the finest level,
+ *   z = D_full^-1 r + P C P^T r,
+ * with C a V-cycle over the coarse levels (one damped block-Jacobi sweep
+ * before and after each coarse correction, four on the coarsest level).
+ * The additive form needs no product with the fine matrix, which is most of
+ * an iteration's cost: a full V-cycle from the finest level cut the
+ * iterations further but cost more than it saved (docs/model.md). With it
+ * the drape's iterations fall 1.5x at 5,041 particles and 1.7x at 10,201. Equal
+ * sweeps before and after make C symmetric positive definite, and so is z's
+ * operator, as conjugate gradients need. Every loop gathers per node in a
+ * fixed order: the same bits for any thread count. */
+#ifndef WC_MULTIGRID_H
+#define WC_MULTIGRID_H
+
+#include <stdint.h>
+
+/// Cloths with fewer particles get no coarse levels: below about this size
+/// the coarse levels cost more per iteration than they save in iterations
+/// (measured on the thesis drape at 12 steps per frame: 7 % slower at 2,500
+/// particles, 1.10x and 1.14x faster at 5,041 and 10,201; docs/model.md).
+#define WC_MULTIGRID_MIN_PARTICLES 4096
+
+typedef struct wc_multigrid wc_multigrid;
+
+/// The coarse levels of a cloth of n particles: the links' ends (`links` of
+/// them), each particle's links as CSR (`adj_start`, n + 1 entries; an entry
+/// k >= 0 is link k with the particle at its first end, ~k at its second),
+/// and how many of the first links define the neighbours that aggregates
+/// are made of (the stretch links: the bend links reach one particle further
+/// and would make aggregates too large). The arrays are borrowed and must
+/// outlive the result. Sets *out to NULL when the cloth is too small to
+/// coarsen (or does not shrink); returns 1 when out of memory, else 0.
+int wc_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const int32_t *end_b,
+                        int32_t neighbour_links, const int32_t *adj_start, const int32_t *adj,
+                        wc_multigrid **out);
+void wc_multigrid_destroy(wc_multigrid *mg);
+
+/// Levels including the finest.
+int32_t wc_multigrid_levels(const wc_multigrid *mg);
+
+/// The step's matrix: per particle the mass with drag (`mass_diag`, a
+/// multiple of the identity), per link its block (6 values: xx, xy, xz, yy,
+/// yz, zz), and the pins (`pin_slot` >= 0: pinned; their rows and columns
+/// are removed). The arrays are borrowed until the next update.
+void wc_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
+                         const int32_t *pin_slot, int threads);
+
+/// z += P C P^T r, the coarse levels' part of the preconditioner; r is
+/// zero at pins and z is left unchanged there.
+void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads);
+
+/* For tests (tests/test_multigrid.c): a level's node count, the aggregate
+ * (node of level + 1) of one of its nodes, and the product with a coarse
+ * level's matrix, out = A in (level >= 1, after an update). */
+int32_t wc_multigrid_level_size(const wc_multigrid *mg, int32_t level);
+int32_t wc_multigrid_aggregate(const wc_multigrid *mg, int32_t level, int32_t node);
+void wc_multigrid_level_product(wc_multigrid *mg, int32_t level, const double *in, double *out);
+
+#endif
