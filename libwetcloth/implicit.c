@@ -38,6 +38,14 @@ struct wc_implicit_state {
     /// search direction, matrix times direction.
     double *v0, *fixed, *rhs, *y, *r, *z, *p, *q;
     double *partial;
+    /// The link blocks again, row by row: entry k of the cloth's link list
+    /// (c->link_start, c->link_list) holds its link's block and the particle
+    /// at the link's other end, and each link's entries in the rows of its
+    /// first and second end are slot_a and slot_b. The product with the
+    /// matrix, run once or more per iteration, then reads each row's blocks
+    /// in one sweep instead of gathering them by link.
+    double *row_block;
+    int32_t *row_other, *slot_a, *slot_b;
     /// The preconditioner's coarse levels; NULL for a cloth too small to
     /// gain from them (multigrid.h).
     wc_multigrid *multigrid;
@@ -53,6 +61,10 @@ void wc_implicit_state_destroy(wc_implicit_state *s)
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
     wc_free(s->end_a);
     wc_free(s->end_b);
+    wc_free(s->row_block);
+    wc_free(s->row_other);
+    wc_free(s->slot_a);
+    wc_free(s->slot_b);
     wc_multigrid_destroy(s->multigrid);
     wc_free(s);
 }
@@ -77,14 +89,24 @@ wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
     for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
         ok &= (*vectors[i] = wc_alloc_array(3 * n, sizeof(double))) != NULL;
     s->partial = wc_alloc_array((size_t)s->chunks, sizeof(double));
+    size_t entries = (size_t)c->link_start[n];
+    s->row_block = wc_alloc_array(6 * entries + 1, sizeof(double));
+    s->row_other = wc_alloc_array(entries + 1, sizeof(int32_t));
+    s->slot_a = wc_alloc_array(links + 1, sizeof(int32_t));
+    s->slot_b = wc_alloc_array(links + 1, sizeof(int32_t));
     if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
-        !s->partial) {
+        !s->partial || !s->row_block || !s->row_other || !s->slot_a || !s->slot_b) {
         wc_implicit_state_destroy(s);
         return NULL;
     }
     for (int32_t e = 0; e < st->count; ++e) s->end_a[e] = st->a[e], s->end_b[e] = st->b[e];
     for (int32_t e = 0; e < bd->count; ++e)
         s->end_a[st->count + e] = bd->a[e], s->end_b[st->count + e] = bd->b[e];
+    for (size_t k = 0; k < entries; ++k) {
+        int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
+        if (entry >= 0) s->slot_a[e] = (int32_t)k, s->row_other[k] = s->end_b[e];
+        else s->slot_b[e] = (int32_t)k, s->row_other[k] = s->end_a[e];
+    }
     if (wc_multigrid_create(s->n, s->links, s->end_a, s->end_b, st->count, c->link_start,
                             c->link_list, &s->multigrid)) {
         wc_implicit_state_destroy(s);
@@ -181,6 +203,8 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
         block_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
                     v0[3 * a + 2] - v0[3 * b + 2], kv);
         set_block(blk, h * h * along + h * damp, h * h * across, ux, uy, uz);
+        memcpy(s->row_block + 6 * (size_t)s->slot_a[e], blk, 6 * sizeof *blk);
+        memcpy(s->row_block + 6 * (size_t)s->slot_b[e], blk, 6 * sizeof *blk);
     }
     return 0;
 }
@@ -276,10 +300,10 @@ static int apply_range(void *context, int64_t begin, int64_t end)
         double md = s->mass_diag[i];
         double ox = md * vi[0], oy = md * vi[1], oz = md * vi[2];
         for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
-            int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
-            const double *vj = in + 3 * (size_t)(entry >= 0 ? s->end_b[e] : s->end_a[e]);
+            const double *vj = in + 3 * (size_t)s->row_other[k];
             double t[3];
-            block_times(s->block + 6 * (size_t)e, vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2], t);
+            block_times(s->row_block + 6 * (size_t)k, vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2],
+                        t);
             ox += t[0], oy += t[1], oz += t[2];
         }
         o[0] = ox, o[1] = oy, o[2] = oz;

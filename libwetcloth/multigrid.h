@@ -39,7 +39,7 @@
 /// Cloths with fewer particles get no coarse levels: below about this size
 /// the coarse levels cost more per iteration than they save in iterations
 /// (measured on the thesis drape at 12 steps per frame: 7 % slower at 2,500
-/// particles, 1.10x and 1.14x faster at 5,041 and 10,201; docs/model.md).
+/// particles, 1.2x and 1.3-1.45x faster at 5,041 and 10,201; docs/model.md).
 #define WC_MULTIGRID_MIN_PARTICLES 4096
 
 typedef struct wc_multigrid wc_multigrid;
