@@ -557,6 +557,7 @@ def run(scene, out_dir, progress=True, check="every", threads=None, frames=None,
                 s = world.stats
                 record = {"frame": f, "substeps": used, "seconds": wall,
                           "phase_seconds": s["phase_seconds"],
+                          "solver_iterations": s["solver_iterations"],
                           "collider_contacts": s["collider_contacts"],
                           "cloth_contacts": s["cloth_contacts"],
                           "failsafe_particles": s["failsafe_particles"],
@@ -641,6 +642,12 @@ def _stats(scene, built, per_frame, frame_count, sim_seconds, check_seconds, tot
             # the library's own split of the simulation time
             "by_phase": {k: sum(r["phase_seconds"][k] for r in per_frame)
                          for k in ("forces", "integrate", "collide", "wet")},
+        },
+        # the implicit integrator's conjugate-gradient iterations (0 for the others)
+        "solver_iterations": {
+            "total": sum(r["solver_iterations"] for r in per_frame),
+            "per_step_mean": sum(r["solver_iterations"] for r in per_frame)
+            / max(1, built.world.stats["steps"]),
         },
         "contacts": {
             "collider_final": per_frame[-1]["collider_contacts"],
