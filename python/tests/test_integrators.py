@@ -39,19 +39,3 @@ def test_scene_integrator_field():
     with pytest.raises(scene.SceneError, match=r"integrator: expected one of"):
         scene.from_dict(dict(base, integrator="euler"), "test.json", ".")
 
-
-@pytest.mark.parametrize("name", ["verlet", "implicit"])
-def test_scene_stats_count_the_solver_iterations(name, tmp_path):
-    """stats.json sums the implicit integrator's conjugate-gradient
-    iterations over the run (its per-frame records hold each frame's), at
-    least one per step; the other integrators solve no system and report 0."""
-    d = {"cloths": [{"grid": {"nu": 8, "nv": 8}}], "integrator": name}
-    s = scene.from_dict(d, "test.json", ".")
-    stats = scene.run(s, str(tmp_path / "out"), progress=False, frames=3)
-    total = stats["solver_iterations"]["total"]
-    assert total == sum(r["solver_iterations"] for r in stats["per_frame"])
-    if name == "verlet":
-        assert total == 0
-    else:
-        assert total >= stats["steps"] > 0
-        assert stats["solver_iterations"]["per_step_mean"] == total / stats["steps"]
