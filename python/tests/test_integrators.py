@@ -38,4 +38,3 @@ def test_scene_integrator_field():
     assert s.integrator == "implicit"
     with pytest.raises(scene.SceneError, match=r"integrator: expected one of"):
         scene.from_dict(dict(base, integrator="euler"), "test.json", ".")
-
