@@ -158,13 +158,6 @@ static void set_block(double *b, double along, double across, double ux, double 
     b[3] = along * uy * uy + across, b[4] = along * uy * uz, b[5] = along * uz * uz + across;
 }
 
-static void block_times(const double *b, double x, double y, double z, double out[3])
-{
-    out[0] = b[0] * x + b[1] * y + b[2] * z;
-    out[1] = b[1] * x + b[3] * y + b[4] * z;
-    out[2] = b[2] * x + b[4] * y + b[5] * z;
-}
-
 /* Each link's stiffness block K = -df_a/dx_a and B = h^2 K + h C:
  *   stretch, taut (d > l): K = k [(l/d) u u^T + (1 - l/d) I], positive
  *     definite; slack: none (tension only);
@@ -200,7 +193,7 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
         }
         double *kv = s->kv + 3 * (size_t)e, *blk = s->block + 6 * (size_t)e;
         set_block(blk, along, across, ux, uy, uz);
-        block_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
+        wc_sym3_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
                     v0[3 * a + 2] - v0[3 * b + 2], kv);
         set_block(blk, h * h * along + h * damp, h * h * across, ux, uy, uz);
         memcpy(s->row_block + 6 * (size_t)s->slot_a[e], blk, 6 * sizeof *blk);
@@ -271,7 +264,7 @@ static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t en
             if (c->pin_slot[j] >= 0) {
                 double t[3];
                 const double *fj = s->fixed + 3 * (size_t)j;
-                block_times(blk, fj[0], fj[1], fj[2], t);
+                wc_sym3_times(blk, fj[0], fj[1], fj[2], t);
                 bx += t[0], by += t[1], bz += t[2];
             }
         }
@@ -302,7 +295,7 @@ static int apply_range(void *context, int64_t begin, int64_t end)
         for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
             const double *vj = in + 3 * (size_t)s->row_other[k];
             double t[3];
-            block_times(s->row_block + 6 * (size_t)k, vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2],
+            wc_sym3_times(s->row_block + 6 * (size_t)k, vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2],
                         t);
             ox += t[0], oy += t[1], oz += t[2];
         }
@@ -317,7 +310,7 @@ static int precondition_range(void *context, int64_t begin, int64_t end)
     const double *in = pass->in, *precond = pass->state->precond;
     double *out = pass->out;
     for (int64_t i = begin; i < end; ++i)
-        block_times(precond + 6 * (size_t)i, in[3 * (size_t)i], in[3 * (size_t)i + 1],
+        wc_sym3_times(precond + 6 * (size_t)i, in[3 * (size_t)i], in[3 * (size_t)i + 1],
                     in[3 * (size_t)i + 2], out + 3 * (size_t)i);
     return 0;
 }

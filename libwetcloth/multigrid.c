@@ -306,13 +306,6 @@ static void add_block(double *to, const double *b)
     for (int k = 0; k < 6; ++k) to[k] += b[k];
 }
 
-static void block_times(const double *b, const double *x, double out[3])
-{
-    out[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];
-    out[1] = b[1] * x[0] + b[3] * x[1] + b[4] * x[2];
-    out[2] = b[2] * x[0] + b[4] * x[1] + b[5] * x[2];
-}
-
 /* A coarse link's block: the sum of its fine links' blocks, those between
  * free particles (a link to a pin acts on its free end's diagonal). */
 static int coarse_links_range(void *context, int64_t begin, int64_t end)
@@ -391,11 +384,11 @@ static int residual_range(void *context, int64_t begin, int64_t end)
     for (int64_t i = begin; i < end; ++i) {
         const double *xi = l->x + 3 * (size_t)i, *b = l->b + 3 * (size_t)i;
         double t[3], ax[3];
-        block_times(l->diag + 6 * (size_t)i, xi, ax);
+        wc_sym3_times(l->diag + 6 * (size_t)i, xi[0], xi[1], xi[2], ax);
         for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k) {
             const double *xj = l->x + 3 * (size_t)other_end(l, l->adj[k]);
-            double diff[3] = {xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]};
-            block_times(l->block + 6 * (size_t)link_of(l->adj[k]), diff, t);
+            wc_sym3_times(l->block + 6 * (size_t)link_of(l->adj[k]), xi[0] - xj[0], xi[1] - xj[1],
+                          xi[2] - xj[2], t);
             ax[0] += t[0], ax[1] += t[1], ax[2] += t[2];
         }
         double *r = l->r + 3 * (size_t)i;
@@ -404,17 +397,19 @@ static int residual_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-/* x += w D_full^-1 r (p->in == NULL: x = w D_full^-1 b, the first sweep
- * from zero, which needs no residual). */
+/* One damped block-Jacobi sweep, x += w D_full^-1 res, with res = p->in:
+ * the residual l->r, or l->b for the first sweep, which starts from x = 0
+ * (where the residual is b, so it needs no product). */
 static int sweep_range(void *context, int64_t begin, int64_t end)
 {
     const mg_pass *p = context;
     level *l = p->fine;
-    const double *res = p->in ? l->r : l->b;
+    int from_zero = p->in == l->b;
     for (int64_t i = begin; i < end; ++i) {
         double *x = l->x + 3 * (size_t)i, t[3];
-        block_times(l->inv + 6 * (size_t)i, res + 3 * (size_t)i, t);
-        if (!p->in) x[0] = x[1] = x[2] = 0.0;
+        const double *res = p->in + 3 * (size_t)i;
+        wc_sym3_times(l->inv + 6 * (size_t)i, res[0], res[1], res[2], t);
+        if (from_zero) x[0] = x[1] = x[2] = 0.0;
         x[0] += SMOOTHING_WEIGHT * t[0];
         x[1] += SMOOTHING_WEIGHT * t[1];
         x[2] += SMOOTHING_WEIGHT * t[2];
@@ -438,7 +433,7 @@ static void residual(level *l, int threads)
 static void smooth(level *l, int first, int threads)
 {
     if (!first) residual(l, threads);
-    level_loop(l, NULL, sweep_range, first ? NULL : l->r, NULL, l->n, threads);
+    level_loop(l, NULL, sweep_range, first ? l->b : l->r, NULL, l->n, threads);
 }
 
 /* The coarse right-hand side: each aggregate sums its free members'

@@ -18,6 +18,15 @@ static inline double wc_lerp(double a, double b, double t)
     return isfinite(d) ? a + d * t : a * (1.0 - t) + b * t;
 }
 
+/// out = B (x, y, z) for a symmetric 3 x 3 matrix B given as xx, xy, xz,
+/// yy, yz, zz (the link and diagonal blocks of implicit.c and multigrid.c).
+static inline void wc_sym3_times(const double b[6], double x, double y, double z, double out[3])
+{
+    out[0] = b[0] * x + b[1] * y + b[2] * z;
+    out[1] = b[1] * x + b[3] * y + b[4] * z;
+    out[2] = b[2] * x + b[4] * y + b[5] * z;
+}
+
 /// Inverse of a symmetric 3 x 3 matrix given as xx, xy, xz, yy, yz, zz,
 /// into the same layout, by cofactors. A matrix that is not positive
 /// definite (determinant or xx not > 0, NaN included) gets zeros: the
