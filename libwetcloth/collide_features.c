@@ -110,6 +110,45 @@ static int normalize3(double v[3])
     return 1;
 }
 
+/* Points along the step at which turning_cross follows a normal. */
+#define NORMAL_SAMPLES 8
+
+/* The unit normal m(t) = u(t) x v(t) of two vectors moving linearly over
+ * the step (u0 to u1, v0 to v1) at its start and end, with the end's sign
+ * chosen by following the normal along the step as an axis: at each of
+ * NORMAL_SAMPLES points the sign nearest the last point's. A side judged
+ * along m0 at the start then reads the same along m1 at the end unless the
+ * elements crossed. Without this, two edges that pass through parallel
+ * (or a triangle that turns over) within the step, where m(t) vanishes and
+ * comes back reversed, would read as crossed, and the push would take the
+ * cloth through the collider: cloth edges sliding over a sphere's edges,
+ * both tangent to the sphere, do that at 8 implicit steps per frame. A
+ * normal that keeps its length and turns past 90 degrees over the step is
+ * followed too. Returns 0 if m0 or m1 has no direction. */
+static int turning_cross(const double u0[3], const double u1[3], const double v0[3],
+                         const double v1[3], double m0[3], double m1[3])
+{
+    double last[3], u[3], v[3], m[3];
+    cross3(u0, v0, m0);
+    if (!normalize3(m0)) return 0;
+    memcpy(last, m0, sizeof last);
+    for (int k = 1; k <= NORMAL_SAMPLES; ++k) {
+        double t = (double)k / NORMAL_SAMPLES;
+        if (k == NORMAL_SAMPLES) memcpy(u, u1, sizeof u), memcpy(v, v1, sizeof v);
+        else lerp3(u0, u1, t, u), lerp3(v0, v1, t, v);
+        cross3(u, v, m);
+        if (!normalize3(m)) {
+            if (k == NORMAL_SAMPLES) return 0;
+            continue;
+        }
+        if (dot3(m, last) < 0.0)
+            for (int d = 0; d < 3; ++d) m[d] = -m[d];
+        memcpy(last, m, sizeof last);
+    }
+    memcpy(m1, last, sizeof last);
+    return 1;
+}
+
 static void start_of(const wc_cloth *c, int32_t i, double out[3])
 {
     out[0] = c->x[i], out[1] = c->y[i], out[2] = c->z[i];
@@ -493,9 +532,13 @@ static int vertex_triangle(wc_cloth *c, wc_feature_state *s, int32_t t, const do
     if (!hit && ccd)
         hit = wc_ccd_point_triangle(v0, v1, a0, a1, b0, b1, c0, c1, 1e-9 * r, &tc, w);
     if (!hit) return 0;
-    wc_triangle_normal(a1, b1, c1, n1);
-    wc_triangle_normal(a0, b0, c0, n0);
-    if (dot3(n1, n1) == 0.0 || dot3(n0, n0) == 0.0) return 0; /* crushed flat: the edges decide */
+    double ab0[3], ac0[3], ab1[3], ac1[3];
+    for (int d = 0; d < 3; ++d) {
+        ab0[d] = b0[d] - a0[d], ac0[d] = c0[d] - a0[d];
+        ab1[d] = b1[d] - a1[d], ac1[d] = c1[d] - a1[d];
+    }
+    /* crushed flat at either end: the edges decide */
+    if (!turning_cross(ab0, ab1, ac0, ac1, n0, n1)) return 0;
     for (int d = 0; d < 3; ++d) {
         p1[d] = w[0] * a1[d] + w[1] * b1[d] + w[2] * c1[d];
         p0[d] = w[0] * a0[d] + w[1] * b0[d] + w[2] * c0[d];
@@ -516,6 +559,46 @@ static int vertex_triangle(wc_cloth *c, wc_feature_state *s, int32_t t, const do
     return push_element(c, s, idx, w, 3, n, dot3(end_gap, n), r, v_feature, mu, dt);
 }
 
+/* The way an edge-edge contact pushes the cloth's edge, from the collider's
+ * closest point toward the cloth's (unit, into n): `start_gap` and
+ * `end_gap` join the closest points' places at the start and end of the
+ * step, the edges run p-q (collider) and a-b (cloth). `crossed` says the
+ * continuous test saw the edges meet; `ccd` that they moved far enough to
+ * need it. Returns 0 for edges parallel at the start or end: the vertices
+ * decide those. */
+static int edge_push_normal(const double p0[3], const double p1[3], const double q0[3],
+                            const double q1[3], const double a0[3], const double a1[3],
+                            const double b0[3], const double b1[3], const double start_gap[3],
+                            const double end_gap[3], int ccd, int crossed, double r, double n[3])
+{
+    /* Near at the end after a large motion without meeting on the way: the
+     * cloth's edge is on its side still, and the line between the closest
+     * points is the way out. The side judged at the start along the edges'
+     * common normal is not reliable there: the closest points at the start
+     * can lie elsewhere, and the normal of two nearly parallel edges swings
+     * (both happen to cloth edges sliding over a sphere's edges at 8
+     * implicit steps per frame; judged so, the push took the cloth into the
+     * sphere). */
+    double gap = sqrt(dot3(end_gap, end_gap)), t, sp, u;
+    if (ccd && !crossed && gap > 1e-3 * r &&
+        !wc_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &t, &sp, &u)) {
+        for (int d = 0; d < 3; ++d) n[d] = end_gap[d] / gap;
+        return 1;
+    }
+    /* They met, or moved too little to have come round, or touch at the
+     * end: the side they were on at the start decides. */
+    double dp0[3], de0[3], dp1[3], de1[3], m0[3], m1[3];
+    for (int d = 0; d < 3; ++d) {
+        dp0[d] = q0[d] - p0[d], de0[d] = b0[d] - a0[d];
+        dp1[d] = q1[d] - p1[d], de1[d] = b1[d] - a1[d];
+    }
+    if (!turning_cross(dp0, dp1, de0, de1, m0, m1)) return 0;
+    double side = dot3(start_gap, m0);
+    if (side == 0.0) side = dot3(end_gap, m1);
+    for (int d = 0; d < 3; ++d) n[d] = (side < 0.0 ? -1.0 : 1.0) * m1[d];
+    return 1;
+}
+
 /* Collider edge (p, q) against cloth edge e; their boxes over the step
  * overlap (the edge grid's query saw to it). `ccd` and *d2 as for
  * vertex_triangle. */
@@ -528,28 +611,19 @@ static int edge_edge(wc_cloth *c, wc_feature_state *s, int32_t e, const double p
     start_of(c, idx[0], a0), start_of(c, idx[1], b0);
     end_of(c, idx[0], a1), end_of(c, idx[1], b1);
     *d2 = wc_segment_segment_closest(p1, q1, a1, b1, &sp, &u);
-    int hit = *d2 < r * r * (1.0 - SLACK);
+    int hit = *d2 < r * r * (1.0 - SLACK), crossed = 0;
     if (!hit && ccd)
-        hit = wc_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &tc, &sp, &u);
+        hit = crossed = wc_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &tc, &sp, &u);
     if (!hit) return 0;
     /* A contact at an end of either edge is a vertex's business (a cloth
      * particle against a face, or a collider vertex against a triangle). */
     if (sp <= 0.0 || sp >= 1.0 || u <= 0.0 || u >= 1.0) return 0;
-    double c0[3], c1[3], e0[3], e1[3], start_gap[3], end_gap[3], m0[3], m1[3], dp[3], de[3];
+    double c0[3], c1[3], e0[3], e1[3], start_gap[3], end_gap[3], n[3];
     lerp3(p0, q0, sp, c0), lerp3(p1, q1, sp, c1);
     lerp3(a0, b0, u, e0), lerp3(a1, b1, u, e1);
-    for (int d = 0; d < 3; ++d) {
-        start_gap[d] = e0[d] - c0[d], end_gap[d] = e1[d] - c1[d];
-        dp[d] = q0[d] - p0[d], de[d] = b0[d] - a0[d];
-    }
-    cross3(dp, de, m0);
-    for (int d = 0; d < 3; ++d) dp[d] = q1[d] - p1[d], de[d] = b1[d] - a1[d];
-    cross3(dp, de, m1);
-    if (!normalize3(m0) || !normalize3(m1)) return 0; /* parallel edges: the vertices decide */
-    double side = dot3(start_gap, m0);
-    if (side == 0.0) side = dot3(end_gap, m1);
-    double n[3];
-    for (int d = 0; d < 3; ++d) n[d] = (side < 0.0 ? -1.0 : 1.0) * m1[d];
+    for (int d = 0; d < 3; ++d) start_gap[d] = e0[d] - c0[d], end_gap[d] = e1[d] - c1[d];
+    if (!edge_push_normal(p0, p1, q0, q1, a0, a1, b0, b1, start_gap, end_gap, ccd, crossed, r, n))
+        return 0;
     double w[2] = {1.0 - u, u}, v_feature[3];
     for (int d = 0; d < 3; ++d) v_feature[d] = ((1.0 - sp) * (p1[d] - p0[d]) + sp * (q1[d] - q0[d])) / dt;
     return push_element(c, s, idx, w, 2, n, dot3(end_gap, n), r, v_feature, mu, dt);

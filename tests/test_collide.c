@@ -78,6 +78,100 @@ static void rest_on_triangle(void)
     wc_world_destroy(w);
 }
 
+/* One step of a 3-particle cloth (vertices p, moving at velocities v for
+ * one step of dt, no gravity) against a mesh collider; returns the
+ * particles' ends in `end` and the checker's count of cloth-collider
+ * intersections after the step. */
+static int32_t one_step_against(const double *collider, int32_t vertex_count, const int32_t *tris,
+                                int32_t tri_count, const double p[9], const double v[9], double dt,
+                                double end[9])
+{
+    wc_world_def wd = wc_world_def_default();
+    wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0.0;
+    wd.thread_count = 1;
+    wc_world *w = scene_world_from(&wd);
+    wc_mesh_collider_def md = wc_mesh_collider_def_default();
+    md.vertices = collider, md.vertex_count = vertex_count, md.triangles = tris;
+    md.triangle_count = tri_count;
+    int32_t col, cl = -1, f[3] = {0, 1, 2};
+    CHECK(wc_world_add_mesh_collider(w, &md, &col) == WC_OK, "%s", wc_world_last_error(w));
+    wc_mesh_cloth_def d = wc_mesh_cloth_def_default();
+    d.vertices = p, d.vertex_count = 3, d.faces = f, d.face_count = 1;
+    d.material.thickness = CLOTH_THICKNESS;
+    CHECK(wc_world_add_mesh_cloth(w, &d, &cl) == WC_OK, "%s", wc_world_last_error(w));
+    CHECK(wc_cloth_set_velocities(w, cl, v, 3) == WC_OK, "%s", wc_world_last_error(w));
+    CHECK(wc_world_step(w, dt) == WC_OK, "%s", wc_world_last_error(w));
+    wc_cloth_get_positions(w, cl, end, 3);
+    wc_intersection_counts counts;
+    CHECK(wc_world_count_intersections(w, &counts) == WC_OK, "%s", wc_world_last_error(w));
+    wc_world_destroy(w);
+    return counts.cloth_collider;
+}
+
+/* A cloth edge that turns past parallel to a collider edge within a step.
+ * The collider is a small vertical triangle whose top edge lies along x;
+ * the cloth edge AB, twice as long and 0.8 r above it, turns from +10 to
+ * -10 degrees about z, staying above (its ends pass beyond the collider's,
+ * so only the edges touch). The cross product of the two edges vanishes
+ * half-way and comes back reversed. Judging the start's side along it at
+ * the start while pushing along it at the end tilted AB into the collider's
+ * edge (and, in the 101 x 101 drape at 8 implicit steps per frame, pushed
+ * cloth into the sphere). The push must leave both ends at the contact
+ * distance above the collider's edge (to the passes' 1 % slack). */
+static void edge_turning_over_an_edge(void)
+{
+    double collider[9] = {-0.05, 0, 0, 0.05, 0, 0, 0, 0, -0.05};
+    int32_t tri[3] = {0, 1, 2};
+    double r = CLOTH_THICKNESS, z0 = 0.8 * r, half = 0.1, dt = 1e-3;
+    double angle = 10.0 * 3.14159265358979323846 / 180.0;
+    double c = cos(angle) * half, s = sin(angle) * half;
+    /* A and B turn; C, far above, stays */
+    double p[9] = {-c, -s, z0, c, s, z0, 0, 0, z0 + 0.1};
+    double v[9] = {0, 2 * s / dt, 0, 0, -2 * s / dt, 0, 0, 0, 0}, end[9];
+    int32_t crossing = one_step_against(collider, 3, tri, 1, p, v, dt, end);
+    printf("edge turning over an edge: ends at z = %.6f, %.6f (r = %.4f), %d intersections\n",
+           end[2], end[5], r, (int)crossing);
+    for (int i = 0; i < 2; ++i)
+        CHECK(end[3 * i + 2] > 0.98 * r && end[3 * i + 2] < 1.02 * r,
+              "cloth particle %d ends at z = %.6g, expected the contact distance %.4g above the "
+              "collider's edge", i, end[3 * i + 2], r);
+    CHECK(crossing == 0, "%d cloth-collider intersections", (int)crossing);
+}
+
+/* A cloth triangle that turns over above a collider vertex within a step:
+ * the collider is the tip of a pyramid at the origin; the cloth triangle
+ * lies 0.8 r above it, and its third particle moves across the edge of the
+ * other two, so the triangle's normal turns over while the tip ends under
+ * it. Judged along the start's normal, the push took the cloth 4 cm down
+ * past the tip. It must keep the cloth above the tip, at the contact
+ * distance, and the third particle free to cross. */
+static void triangle_turning_over_a_vertex(void)
+{
+    double collider[15] = {0, 0, 0, -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1};
+    int32_t tris[12] = {0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1};
+    double r = CLOTH_THICKNESS, z0 = 0.8 * r, dt = 1e-3;
+    double p[9] = {-0.05, 0.02, z0, 0.05, 0.02, z0, 0, 0.06, z0};
+    double v[9] = {0, 0, 0, 0, 0, 0, 0, -0.12 / dt, 0}, end[9];
+    int32_t crossing = one_step_against(collider, 5, tris, 4, p, v, dt, end);
+    /* where the tip is under the cloth triangle (barycentric coordinates in
+     * the xy plane), and the triangle's height there */
+    double w[3], area = (end[3] - end[0]) * (end[7] - end[1]) - (end[6] - end[0]) * (end[4] - end[1]);
+    for (int k = 0; k < 3; ++k) {
+        const double *p1 = end + 3 * ((k + 1) % 3), *p2 = end + 3 * ((k + 2) % 3);
+        w[k] = (p1[0] * p2[1] - p2[0] * p1[1]) / area;
+    }
+    double z = w[0] * end[2] + w[1] * end[5] + w[2] * end[8];
+    printf("triangle turning over a vertex: the tip under the cloth at (%.3f, %.3f, %.3f), which "
+           "is z = %.6f there (r = %.4f), %d intersections\n", w[0], w[1], w[2], z, r, (int)crossing);
+    CHECK(w[0] > 0.0 && w[1] > 0.0 && w[2] > 0.0,
+          "the collider's vertex ends outside the cloth triangle (barycentric %.3g %.3g %.3g): the "
+          "third particle did not cross", w[0], w[1], w[2]);
+    CHECK(z > 0.98 * r && z < 1.02 * r,
+          "the cloth triangle ends z = %.6g above the collider's vertex, expected the contact "
+          "distance %.4g", z, r);
+    CHECK(crossing == 0, "%d cloth-collider intersections", (int)crossing);
+}
+
 /* Exact distance from a point to each convex shape's surface, for the
  * shapes as placed below (centred at the origin, unrotated). */
 static double surface_distance(wc_shape shape, const double p[3])
@@ -337,6 +431,8 @@ int main(void)
     rest_on_convex(WC_SHAPE_BOX, "box");
     rest_on_convex(WC_SHAPE_CONVEX_HULL, "hull");
     fast_particle();
+    edge_turning_over_an_edge();
+    triangle_turning_over_a_vertex();
     printf("(%.1f s) ", seconds() - t0);
     fast_plate();
     printf("(%.1f s) ", seconds() - t0);
