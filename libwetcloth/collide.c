@@ -172,7 +172,13 @@ typedef struct particle_motion {
  * take at most mu times that change off the tangential part (mu is the
  * square root of `friction`, the product of the two coefficients). The same
  * tangential reduction is applied to this step's displacement, so a
- * particle held by friction does not slide during the step either. */
+ * particle held by friction does not slide during the step either: to the
+ * displacement the particle has at its new place, which for a particle
+ * stopped where its path met the surface is only the part up to there.
+ * Taken off the whole step's motion instead, the reduction would put such
+ * a particle behind where it started, against its motion: at large steps
+ * that ratchet pushed the cloth outward round the sphere's pole every step
+ * until its links there stretched without bound. */
 static void respond(particle_motion *m, const double surface[3], const double n[3],
                     const double v_surface[3], double r, double friction, double wet_keep, double dt)
 {
@@ -191,8 +197,11 @@ static void respond(particle_motion *m, const double surface[3], const double n[
         double keep = speed_t > 0.0 ? 1.0 - mu * (-vn) / speed_t : 1.0;
         if (keep < 0.0) keep = 0.0;
         keep *= wet_keep; /* wet friction (thesis eq. 2.10) in sustained contact */
+        double moved[3];
+        for (int k = 0; k < 3; ++k) moved[k] = m->end[k] - m->from[k] - v_surface[k] * dt;
+        double moved_n = dot3(moved, n);
         for (int k = 0; k < 3; ++k) {
-            m->end[k] -= (1.0 - keep) * tangent[k] * dt;
+            m->end[k] -= (1.0 - keep) * (moved[k] - moved_n * n[k]);
             m->vel[k] = v_surface[k] + keep * tangent[k];
         }
     }

@@ -19,8 +19,9 @@
 #define CLOTH_THICKNESS 0.003
 
 /* A small equilateral triangle cloth (3 particles), horizontal, centred at c:
- * the closest thing to a few free particles the API has. */
-static int32_t add_small_cloth(wc_world *w, const double c[3], double side)
+ * the closest thing to a few free particles the API has; with the given
+ * friction coefficient, or the default. */
+static int32_t add_small_cloth_with(wc_world *w, const double c[3], double side, double friction)
 {
     double h = side * sqrt(3.0) / 2.0;
     double v[9] = {c[0] - side / 2, c[1] - h / 3, c[2], c[0] + side / 2, c[1] - h / 3, c[2],
@@ -32,8 +33,14 @@ static int32_t add_small_cloth(wc_world *w, const double c[3], double side)
     d.faces = f;
     d.face_count = 1;
     d.material.thickness = CLOTH_THICKNESS;
+    d.material.friction = friction;
     CHECK(wc_world_add_mesh_cloth(w, &d, &out) == WC_OK, "%s", wc_world_last_error(w));
     return out;
+}
+
+static int32_t add_small_cloth(wc_world *w, const double c[3], double side)
+{
+    return add_small_cloth_with(w, c, side, wc_mesh_cloth_def_default().material.friction);
 }
 
 static void advance_or_fail(wc_world *w, double frame, int32_t substeps)
@@ -75,6 +82,45 @@ static void rest_on_triangle(void)
     wc_step_stats s = wc_world_get_stats(w);
     CHECK(s.collider_contacts == 3 && s.failsafe_particles == 0, "contacts %d failsafe %d",
           s.collider_contacts, s.failsafe_particles);
+    wc_world_destroy(w);
+}
+
+/* Friction that holds a particle where its path met a collider triangle:
+ * the small cloth moves down steeply (10 cm down for every 1 cm across in
+ * one step) and meets a horizontal triangle 6 % of the way along its path.
+ * With both friction coefficients 1 the normal change (100 m/s) exceeds
+ * the tangential speed (10 m/s), so the particles stick: each must end at
+ * the contact distance straight above where it started, neither carried on
+ * across nor (as when the whole step's sideways motion was taken off the
+ * place where the path met the triangle) 9.4 mm behind its start. */
+static void friction_holds_where_it_met(void)
+{
+    wc_world_def wd = wc_world_def_default();
+    wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0.0;
+    wd.thread_count = 1;
+    wc_world *w = scene_world_from(&wd);
+    double verts[9] = {-1, -1, 0, 2, -1, 0, -1, 2, 0};
+    int32_t tri[3] = {0, 1, 2}, col;
+    wc_mesh_collider_def md = wc_mesh_collider_def_default();
+    md.vertices = verts, md.vertex_count = 3, md.triangles = tri, md.triangle_count = 1;
+    md.friction = 1.0;
+    CHECK(wc_world_add_mesh_collider(w, &md, &col) == WC_OK, "%s", wc_world_last_error(w));
+    double r = CLOTH_THICKNESS, c[3] = {0, 0, 2 * r}, dt = 1e-3, start[9], v[9], end[9];
+    int32_t cl = add_small_cloth_with(w, c, 0.02, 1.0);
+    for (int i = 0; i < 3; ++i) v[3 * i] = 10.0, v[3 * i + 1] = 0.0, v[3 * i + 2] = -100.0;
+    wc_cloth_get_positions(w, cl, start, 3);
+    CHECK(wc_cloth_set_velocities(w, cl, v, 3) == WC_OK, "%s", wc_world_last_error(w));
+    CHECK(wc_world_step(w, dt) == WC_OK, "%s", wc_world_last_error(w));
+    wc_cloth_get_positions(w, cl, end, 3);
+    double worst = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        worst = fmax(worst, fabs(end[3 * i] - start[3 * i]));
+        CHECK(fabs(end[3 * i] - start[3 * i]) <= 1e-12 && fabs(end[3 * i + 1] - start[3 * i + 1]) <= 1e-12,
+              "particle %d slid from x = %.9g to %.9g under sticking friction", i, start[3 * i], end[3 * i]);
+        CHECK(fabs(end[3 * i + 2] - r) <= 1e-12, "particle %d ends at z = %.9g, expected %.9g", i,
+              end[3 * i + 2], r);
+    }
+    printf("friction holds where the path met the triangle: largest slide %.3g m\n", worst);
     wc_world_destroy(w);
 }
 
@@ -431,6 +477,7 @@ int main(void)
     rest_on_convex(WC_SHAPE_BOX, "box");
     rest_on_convex(WC_SHAPE_CONVEX_HULL, "hull");
     fast_particle();
+    friction_holds_where_it_met();
     edge_turning_over_an_edge();
     triangle_turning_over_a_vertex();
     printf("(%.1f s) ", seconds() - t0);
