@@ -43,6 +43,17 @@ static int32_t add_small_cloth(wc_world *w, const double c[3], double side)
     return add_small_cloth_with(w, c, side, wc_mesh_cloth_def_default().material.friction);
 }
 
+/* A big horizontal triangle collider at z = 0 round the origin. */
+static void add_floor_triangle(wc_world *w, double thickness, double friction)
+{
+    double verts[9] = {-1, -1, 0, 2, -1, 0, -1, 2, 0};
+    int32_t tri[3] = {0, 1, 2}, col;
+    wc_mesh_collider_def md = wc_mesh_collider_def_default();
+    md.vertices = verts, md.vertex_count = 3, md.triangles = tri, md.triangle_count = 1;
+    md.thickness = thickness, md.friction = friction;
+    CHECK(wc_world_add_mesh_collider(w, &md, &col) == WC_OK, "%s", wc_world_last_error(w));
+}
+
 static void advance_or_fail(wc_world *w, double frame, int32_t substeps)
 {
     wc_status s = wc_world_advance(w, frame, substeps);
@@ -58,12 +69,7 @@ static void advance_or_fail(wc_world *w, double frame, int32_t substeps)
 static void rest_on_triangle(void)
 {
     wc_world *w = scene_world(1);
-    double verts[9] = {-1, -1, 0, 2, -1, 0, -1, 2, 0};
-    int32_t tri[3] = {0, 1, 2}, col;
-    wc_mesh_collider_def md = wc_mesh_collider_def_default();
-    md.vertices = verts, md.vertex_count = 3, md.triangles = tri, md.triangle_count = 1;
-    md.thickness = 0.002;
-    CHECK(wc_world_add_mesh_collider(w, &md, &col) == WC_OK, "%s", wc_world_last_error(w));
+    add_floor_triangle(w, 0.002, wc_mesh_collider_def_default().friction);
     double c[3] = {0, 0, 0.05};
     int32_t cl = add_small_cloth(w, c, 0.02);
     for (int f = 0; f < 24; ++f) advance_or_fail(w, 1.0 / 24, 0);
@@ -99,12 +105,7 @@ static void friction_holds_where_it_met(void)
     wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0.0;
     wd.thread_count = 1;
     wc_world *w = scene_world_from(&wd);
-    double verts[9] = {-1, -1, 0, 2, -1, 0, -1, 2, 0};
-    int32_t tri[3] = {0, 1, 2}, col;
-    wc_mesh_collider_def md = wc_mesh_collider_def_default();
-    md.vertices = verts, md.vertex_count = 3, md.triangles = tri, md.triangle_count = 1;
-    md.friction = 1.0;
-    CHECK(wc_world_add_mesh_collider(w, &md, &col) == WC_OK, "%s", wc_world_last_error(w));
+    add_floor_triangle(w, 0.0, 1.0);
     double r = CLOTH_THICKNESS, c[3] = {0, 0, 2 * r}, dt = 1e-3, start[9], v[9], end[9];
     int32_t cl = add_small_cloth_with(w, c, 0.02, 1.0);
     for (int i = 0; i < 3; ++i) v[3 * i] = 10.0, v[3 * i + 1] = 0.0, v[3 * i + 2] = -100.0;
