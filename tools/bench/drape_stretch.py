@@ -21,17 +21,38 @@ import wetcloth
 from wetcloth.demo import uv_sphere
 
 
+def _at_least(low):
+    """An argparse type: an integer >= low, else an error naming both."""
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError("must be an integer >= %d, got %r" % (low, text))
+        if value < low:
+            raise argparse.ArgumentTypeError("must be at least %d, got %d" % (low, value))
+        return value
+    return parse
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--size", type=int, default=101, help="particles per side (n x n)")
+    ap.add_argument("--size", type=_at_least(2), default=101, help="particles per side (n x n)")
     ap.add_argument("--integrator", default="implicit", choices=sorted(wetcloth.World.INTEGRATORS))
-    ap.add_argument("--steps", type=int, default=10, help="steps per frame of 1/24 s")
-    ap.add_argument("--frames", type=int, default=12)
+    ap.add_argument("--steps", type=_at_least(1), default=10, help="steps per frame of 1/24 s")
+    ap.add_argument("--frames", type=_at_least(1), default=12)
     ap.add_argument("--sphere", default="mesh", choices=("mesh", "exact"),
                     help="the 114-vertex UV sphere, or libccd's exact sphere")
-    ap.add_argument("--friction", type=float, default=0.3, help="the sphere's friction")
-    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--friction", type=float, default=0.3, help="the sphere's friction, [0, 10]")
+    ap.add_argument("--threads", type=_at_least(0), default=1, help="0 = OpenMP's default")
     a = ap.parse_args(argv)
+    try:
+        return run(a)
+    except wetcloth.WetclothError as e:
+        ap.error(str(e))
+
+
+def run(a):
+    """The drape with the parsed arguments `a`, its table on stdout."""
     w = wetcloth.World(integrator=a.integrator, threads=a.threads)
     if a.sphere == "mesh":
         v, t = uv_sphere()
