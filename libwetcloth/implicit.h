@@ -27,9 +27,11 @@ double wc_implicit_last_residual(const wc_implicit_state *state);
 
 /// Writes the positions after a step of dt into cloth->nx/ny/nz, x + dt v1,
 /// with v1 from the solve above and the forces in cloth->fx/fy/fz. Pinned
-/// particles go where Verlet puts them. Returns the index of the first
-/// particle whose new position is not finite, or -1 when all are.
-/// cloth->implicit must exist.
-int32_t wc_integrate_implicit(wc_cloth *cloth, double dt, double pin_fraction, int threads);
+/// particles go where Verlet puts them. The solve stops when its estimated
+/// velocity error is at most tolerance * dt (wc_world_def.implicit_tolerance,
+/// m/s^2; 0: to round-off). Returns the index of the first particle whose
+/// new position is not finite, or -1 when all are. cloth->implicit must exist.
+int32_t wc_integrate_implicit(wc_cloth *cloth, double dt, double pin_fraction, double tolerance,
+                              int threads);
 
 #endif

@@ -36,6 +36,7 @@ wc_world_def wc_world_def_default(void)
     d.integrator = WC_INTEGRATOR_VERLET;
     d.substep_safety = 0.9;
     d.max_substeps = 100000;
+    d.implicit_tolerance = 0.5;
     return d;
 }
 
@@ -62,6 +63,10 @@ static wc_status validate_world_def(const wc_world_def *d, wc_message *msg)
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.max_substeps must be in [1, 10000000] but is %d",
                        (int)d->max_substeps);
+    if (!(d->implicit_tolerance >= 0.0 && d->implicit_tolerance <= 1000.0))
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "world_def.implicit_tolerance must be in [0, 1000] m/s^2 but is %g",
+                       d->implicit_tolerance);
     return WC_OK;
 }
 
@@ -239,7 +244,7 @@ static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_f
         return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
     case WC_INTEGRATOR_IMPLICIT:
         if (!cl->implicit && !(cl->implicit = wc_implicit_state_create(cl))) break;
-        bad = wc_integrate_implicit(cl, dt, pin_fraction, threads);
+        bad = wc_integrate_implicit(cl, dt, pin_fraction, w->def.implicit_tolerance, threads);
         w->solver_iterations += wc_implicit_last_iterations(cl->implicit);
         return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
     default:

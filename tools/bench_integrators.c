@@ -13,6 +13,11 @@
  *                        fewest it is stable at)
  *     target=0.01        error bound of the summary
  *     stop=1             stop a sweep at the first setting within target
+ *     tolerance=0.5      the implicit integrator's solve tolerance, m/s^2
+ *                        (wc_world_def.implicit_tolerance; default the
+ *                        library's); its references at 8x the steps always
+ *                        solve to round-off (tolerance 0), so the error
+ *                        column includes what the tolerance costs
  *     reference=1        0: time the runs only, without the references at 8x
  *                        the steps and without Verlet's run (error and vs
  *                        verlet print as nan, no summary): for comparing the
@@ -48,7 +53,7 @@
 #define MAX_LIST 32
 
 typedef struct options {
-    double seconds, target;
+    double seconds, target, tolerance;
     int threads, stop, reference;
     int sizes[MAX_LIST], size_count;
     int selfs[MAX_LIST], self_count;
@@ -69,10 +74,12 @@ typedef struct run_result {
 
 static const char *const NAMES[3] = {"verlet", "xpbd", "implicit"};
 
-static wc_world *make_world(int size, int self, int integrator, int threads, int32_t *cloth)
+static wc_world *make_world(int size, int self, int integrator, int threads, double tolerance,
+                            int32_t *cloth)
 {
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
+    wd.implicit_tolerance = tolerance;
     wd.integrator = (wc_integrator)integrator;
     wd.max_substeps = 10000000;
     wc_world *w = NULL;
@@ -98,11 +105,13 @@ static double cpu_now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* substeps 0: the integrator's automatic count (its own stable step). */
-static run_result run(const options *o, int size, int self, int integrator, int substeps)
+/* substeps 0: the integrator's automatic count (its own stable step).
+ * tolerance: the implicit integrator's (o->tolerance, or 0 for a reference). */
+static run_result run(const options *o, int size, int self, int integrator, int substeps,
+                      double tolerance)
 {
     int32_t cl;
-    wc_world *w = make_world(size, self, integrator, o->threads, &cl);
+    wc_world *w = make_world(size, self, integrator, o->threads, tolerance, &cl);
     run_result r;
     memset(&r, 0, sizeof r);
     r.frames = (int)lround(o->seconds * 24);
@@ -192,10 +201,10 @@ static best sweep(const options *o, int size, int self, int integrator, const ru
     for (int k = 0; k < count; ++k) {
         /* Verlet's run at its automatic count is the one passed in */
         int reuse = integrator == 0 && verlet;
-        run_result r = reuse ? *verlet : run(o, size, self, integrator, counts[k]);
+        run_result r = reuse ? *verlet : run(o, size, self, integrator, counts[k], o->tolerance);
         run_result ref;
         memset(&ref, 0, sizeof ref);
-        if (o->reference) ref = run(o, size, self, integrator, 8 * r.substeps);
+        if (o->reference) ref = run(o, size, self, integrator, 8 * r.substeps, 0.0);
         double error = o->reference ? rms_error(&r, &ref) : NAN;
         double vs_verlet = verlet ? rms_error(&r, verlet) : NAN;
         print_row(size, self, integrator, &r, error, vs_verlet);
@@ -236,6 +245,7 @@ static options parse(int argc, char **argv)
     options o;
     memset(&o, 0, sizeof o);
     o.seconds = 0.5, o.threads = 1, o.target = 0.01, o.stop = 1, o.reference = 1;
+    o.tolerance = wc_world_def_default().implicit_tolerance;
     o.size_count = parse_list("20,101", o.sizes, 0);
     o.self_count = parse_list("0,1", o.selfs, 0);
     o.integrator_count = parse_list("verlet,xpbd,implicit", o.integrators, 1);
@@ -253,6 +263,7 @@ static options parse(int argc, char **argv)
         else if (!strncmp(argv[i], "target", len)) o.target = atof(v);
         else if (!strncmp(argv[i], "stop", len)) o.stop = atoi(v);
         else if (!strncmp(argv[i], "reference", len)) o.reference = atoi(v);
+        else if (!strncmp(argv[i], "tolerance", len)) o.tolerance = atof(v);
         else if (!strncmp(argv[i], "sizes", len)) o.size_count = parse_list(v, o.sizes, 0);
         else if (!strncmp(argv[i], "self", len)) o.self_count = parse_list(v, o.selfs, 0);
         else if (!strncmp(argv[i], "integrators", len))
@@ -269,12 +280,14 @@ static options parse(int argc, char **argv)
 int main(int argc, char **argv)
 {
     options o = parse(argc, argv);
-    printf("thesis drape, %.2f s simulated (%d frames of 1/24 s), %d thread(s). error: RMS "
-           "distance over particles and frames to the same integrator at 8x the substeps, / 1 m; "
+    printf("thesis drape, %.2f s simulated (%d frames of 1/24 s), %d thread(s), implicit "
+           "tolerance %g m/s^2. error: RMS "
+           "distance over particles and frames to the same integrator at 8x the substeps (solved "
+           "to round-off), / 1 m; "
            "vs verlet: the same against Verlet at its automatic step. ms per simulated frame, "
            "its CPU time (cpu ms, all threads), the phases forces / integration / collisions (wall). x blender: Blender's ms per frame "
            "(NOTES) / ours. cg/step: the implicit integrator's conjugate-gradient iterations per substep.\n\n",
-           o.seconds, (int)lround(o.seconds * 24), o.threads);
+           o.seconds, (int)lround(o.seconds * 24), o.threads, o.tolerance);
     printf("%-9s %-4s %-9s %8s %10s %8s %7s %7s %7s %10s %10s %9s %8s\n", "particles", "self",
            "integr.", "steps/fr", "ms/frame", "cpu ms", "force", "integr", "collide", "error", "vs verlet",
            "x blender", "cg/step");
@@ -285,7 +298,7 @@ int main(int argc, char **argv)
             int n = o.sizes[s], self = o.selfs[si];
             run_result verlet;
             memset(&verlet, 0, sizeof verlet);
-            if (o.reference) verlet = run(&o, n, self, 0, 0);
+            if (o.reference) verlet = run(&o, n, self, 0, 0, 0.0);
             best verlet_best = {0, 0, 0.0, 0.0, 0.0};
             for (int k = 0; k < o.integrator_count; ++k) {
                 int integrator = o.integrators[k];
