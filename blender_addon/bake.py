@@ -225,6 +225,8 @@ def _world_settings(settings, scene):
     substeps = "automatic" if settings.substeps_auto else settings.substeps
     return (("frame range", "%d to %d" % props.frame_range(settings, scene)),
             ("integrator", settings.integrator),
+            ("solver tolerance", settings.implicit_tolerance
+             if settings.integrator == "IMPLICIT" else None),
             ("substeps", substeps))
 
 
@@ -492,7 +494,8 @@ class Baker:
         together = len(self.parts) > 1
         try:
             self.world = wetcloth.World(gravity=gravity,
-                                        integrator=props.integrator_name(self.settings))
+                                        integrator=props.integrator_name(self.settings),
+                                        implicit_tolerance=self.settings.implicit_tolerance)
             for p, positions in zip(self.parts, start_world):
                 p.add_to(self.world, wetcloth, positions,
                          not together or p.settings.collide_with_cloths)

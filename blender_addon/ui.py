@@ -127,6 +127,8 @@ class PHYSICS_PT_wet_cloth_cache(_WetClothSubPanel, bpy.types.Panel):
             sub.prop(s, "frame_start", text="Frame Start")
             sub.prop(s, "frame_end", text="End")
         col.prop(s, "integrator")
+        if s.integrator == "IMPLICIT":
+            col.prop(s, "implicit_tolerance")
         col.prop(s, "substeps_auto")
         sub = col.column()
         sub.active = not s.substeps_auto

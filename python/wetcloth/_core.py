@@ -201,6 +201,10 @@ class World:
     integrator     "verlet" (default, explicit), "xpbd" (strain-limited
                    stretch) or "implicit" (semi-implicit backward Euler);
                    see docs/model.md
+    implicit_tolerance  the implicit integrator's solve tolerance, m/s^2,
+                   [0, 1000]: its linear solve stops at an estimated
+                   velocity error of this times the step; 0 solves to
+                   round-off. None: the library's default (0.5)
 
     Use as a context manager, or call close(), to free the C world at once;
     otherwise it is freed when the World and all its cloths and colliders
@@ -211,7 +215,7 @@ class World:
                    "implicit": "WC_INTEGRATOR_IMPLICIT"}
 
     def __init__(self, gravity=(0.0, 0.0, -9.81), threads=0, substep_safety=0.9,
-                 max_substeps=100000, integrator="verlet"):
+                 max_substeps=100000, integrator="verlet", implicit_tolerance=None):
         if not isinstance(integrator, str) or integrator not in World.INTEGRATORS:
             raise _bad("integrator must be one of %s but is %r"
                        % (", ".join(repr(k) for k in World.INTEGRATORS), integrator))
@@ -221,6 +225,8 @@ class World:
         d.thread_count = _int32("threads", threads)
         d.substep_safety = _float("substep_safety", substep_safety)
         d.max_substeps = _int32("max_substeps", max_substeps)
+        if implicit_tolerance is not None:
+            d.implicit_tolerance = _float("implicit_tolerance", implicit_tolerance)
         out = ffi.new("wc_world **")
         msg = ffi.new("wc_message *")
         status = lib.wc_world_create(ffi.new("wc_world_def *", d), out, msg)

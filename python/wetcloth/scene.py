@@ -176,7 +176,8 @@ def check_vector(fail, key, v, size):
 
 MATERIAL_FIELDS = list(_core._MATERIAL_FIELDS)
 SCENE_FIELDS = ["description", "format_version", "duration", "fps", "substeps", "threads",
-                "gravity", "start_frame", "integrator", "cloths", "colliders"]
+                "gravity", "start_frame", "integrator", "implicit_tolerance", "cloths",
+                "colliders"]
 CLOTH_FIELDS = ["name", "grid", "obj", "material", "wetness", "pins", "pin_keyframes",
                 "self_collision", "collide_with_cloths"]
 GRID_FIELDS = ["nu", "nv", "size", "center", "axis_u", "axis_v"]
@@ -272,6 +273,8 @@ def from_dict(data, source, base_dir):
     s.threads = r.integer("threads", 0, minimum=0, maximum=1024)
     s.gravity = r.vector("gravity", 3, [0.0, 0.0, -9.81])
     s.integrator = r.string("integrator", "verlet", choices=["verlet", "xpbd", "implicit"])
+    # None: the library's default
+    s.implicit_tolerance = r.number("implicit_tolerance", None, minimum=0.0, maximum=1000.0)
     s.start_frame = r.number("start_frame", 1.0)
     if s.duration * s.fps > 1e6:
         r.fail("duration", "duration x fps must be at most 1e6 frames, found %g" %
@@ -447,7 +450,7 @@ def build(scene, threads=None):
 
     world = guarded("gravity", World, gravity=scene.gravity,
                     threads=scene.threads if threads is None else threads,
-                    integrator=scene.integrator)
+                    integrator=scene.integrator, implicit_tolerance=scene.implicit_tolerance)
     b = Built(scene, world)
     try:
         for c in scene.cloths:

@@ -563,7 +563,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (odd & 1)
         for (int k = 0; k < 3; ++k) def.gravity[k] = num(&r, def.gravity[k]);
     def.thread_count = (odd & 2) ? (int32_t)u32(&r) : 1;
-    if (odd & 4) def.integrator = (wc_integrator)(int32_t)(u8(&r) % 5) - 1;
+    if (odd & 4) {
+        def.integrator = (wc_integrator)(int32_t)(u8(&r) % 5) - 1;
+        def.implicit_tolerance = num(&r, 0.5);
+    }
     if (odd & 8) def.substep_safety = num(&r, 0.9);
     if (odd & 16) def.max_substeps = count(&r, 64);
     if (def.thread_count > 2 && def.thread_count <= 1024) def.thread_count = 2;

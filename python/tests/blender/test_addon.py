@@ -222,6 +222,25 @@ def test_integrator_choice_drapes_in_fewer_substeps(empty_scene, cache_dir, inte
     assert np.abs(frames[-1] - verlet_frames[-1]).max() > 1e-6
 
 
+def test_solver_tolerance_reaches_the_world(empty_scene, cache_dir):
+    """The Semi-Implicit panel's Solver Tolerance reaches the library: the
+    same drape solved to round-off and at a loose tolerance bakes two
+    different, finite caches (test_bake_all checks that objects baked
+    together must agree on it)."""
+    add_sphere()
+    cloth = add_cloth(cache_dir)
+    s = cloth.wet_cloth
+    s.integrator = "IMPLICIT"
+    assert s.implicit_tolerance == 0.5
+    baked = []
+    for tolerance in (0.0, 5.0):
+        s.implicit_tolerance = tolerance
+        assert bake(cloth) == {"FINISHED"}
+        baked.append(read_pc2(cache_path(cloth))[1])
+    assert all(np.isfinite(f).all() for f in baked)
+    assert np.abs(baked[0][-1] - baked[1][-1]).max() > 1e-6
+
+
 def test_mesh_cache_plays_the_cache(draped):
     cloth, _sphere, original = draped
     mod = cloth.modifiers["Wet Cloth Cache"]

@@ -156,7 +156,13 @@ def test_bake_all_errors_and_failures_keep_previous(empty_scene, cache_dir):
     upper.wet_cloth.use_scene_range = True
     upper.wet_cloth.integrator = "XPBD"
     assert "same integrator" in bake_all_error()
-    upper.wet_cloth.integrator = "VERLET"
+    for ob in (lower, upper):
+        ob.wet_cloth.integrator = "IMPLICIT"
+    upper.wet_cloth.implicit_tolerance = 0.0
+    assert "same solver tolerance" in bake_all_error()
+    for ob in (lower, upper):
+        ob.wet_cloth.integrator = "VERLET"
+    upper.wet_cloth.implicit_tolerance = 0.5
     lower.name, upper.name = "Lo wer", "Lo_wer"  # both cached as Lo_wer.pc2
     assert "would write the same cache" in bake_all_error()
     lower.name, upper.name = "Lower", "Upper"
