@@ -5,7 +5,8 @@
  * links' axial stiffness (their transverse term dropped, as Choi & Ko do,
  * because it would make the matrix indefinite), df/dv the stretch dashpots
  * and air drag. Block-Jacobi preconditioned conjugate gradients (with coarse
- * levels on large cloths, multigrid.h), matrix-free,
+ * levels on large cloths, multigrid.h), stopped at an estimated velocity
+ * error of wc_world_def.implicit_tolerance times the step, matrix-free,
  * gathered per particle with fixed-order reductions: the same bits for any
  * thread count. */
 #ifndef WC_IMPLICIT_H
