@@ -121,7 +121,7 @@ typedef struct wc_world_def {
     /// of at most this size over one step. 0 solves to round-off (residual
     /// 1e-8 of the right-hand side, which also ends every solve). Default
     /// 0.5 (about g / 20): on the thesis drape it leaves the error against a
-    /// fine-step reference solved to round-off where it was, at 2-5x fewer
+    /// fine-step reference solved to round-off where it was, at 2-4x fewer
     /// iterations; larger values are faster still but let a near-
     /// inextensible cloth gain energy (docs/model.md has the figures).
     double implicit_tolerance;
