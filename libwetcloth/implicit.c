@@ -439,7 +439,9 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
         precondition(pass, threads);
         memcpy(s->p, s->z, bytes);
         double rz = dot(pass, s->r, s->z, threads);
-        double bound = velocity_tolerance * velocity_tolerance * free_mass(pass->cloth, s);
+        double bound = velocity_tolerance > 0.0 ? velocity_tolerance * velocity_tolerance *
+                                                      free_mass(pass->cloth, s)
+                                                : 0.0;
         double decrease[ESTIMATE_DELAY] = {0.0};
         for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
             if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)

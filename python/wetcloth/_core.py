@@ -204,7 +204,8 @@ class World:
     implicit_tolerance  the implicit integrator's solve tolerance, m/s^2,
                    [0, 1000]: its linear solve stops at an estimated
                    velocity error of this times the step; 0 solves to
-                   round-off. None: the library's default (0.5)
+                   round-off. None: the library's default,
+                   World.DEFAULT_IMPLICIT_TOLERANCE (0.5)
 
     Use as a context manager, or call close(), to free the C world at once;
     otherwise it is freed when the World and all its cloths and colliders
@@ -213,6 +214,9 @@ class World:
 
     INTEGRATORS = {"verlet": "WC_INTEGRATOR_VERLET", "xpbd": "WC_INTEGRATOR_XPBD",
                    "implicit": "WC_INTEGRATOR_IMPLICIT"}
+    # the library's default (wc_world_def_default), what implicit_tolerance=None
+    # means; set by _init once the library is loaded
+    DEFAULT_IMPLICIT_TOLERANCE = None
 
     def __init__(self, gravity=(0.0, 0.0, -9.81), threads=0, substep_safety=0.9,
                  max_substeps=100000, integrator="verlet", implicit_tolerance=None):
@@ -739,5 +743,6 @@ class ConvexCollider:
 def _init(loaded_lib):
     global lib, Material
     lib = loaded_lib
+    World.DEFAULT_IMPLICIT_TOLERANCE = float(lib.wc_world_def_default().implicit_tolerance)
     Material = _make_material_class()
     return Material

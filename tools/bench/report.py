@@ -154,7 +154,7 @@ def speed_vs_error(out, quick, lines):
               "the distance to the reference at the same frame time, / 1 m. Cost: wall s per "
               "simulated s (one run each). The default setting (Verlet, automatic substeps) is "
               "marked *default*. The implicit integrator solves at the library's default "
-              f"implicit_tolerance ({wetcloth._core.lib.wc_world_def_default().implicit_tolerance:g} m/s^2).", ""]
+              f"implicit_tolerance ({wetcloth.World.DEFAULT_IMPLICIT_TOLERANCE:g} m/s^2).", ""]
     results = {}
     for name, make in scenes.SCENES.items():
         _, _, auto, _ = run_scene(make, n, "verlet", 0, 1)
