@@ -93,8 +93,9 @@ typedef enum wc_integrator {
     /// the stretch links' linearised Jacobian and the bend links' axial
     /// stiffness (their indefinite transverse term dropped, as Choi & Ko do)
     /// in one linear system per step, solved by block-Jacobi preconditioned
-    /// conjugate gradients to wc_world_def.implicit_tolerance. Free fall lags
-    /// the exact parabola by g t dt / 2 (solved to round-off).
+    /// conjugate gradients to wc_world_def.implicit_tolerance. Free fall is
+    /// exact, as with Verlet, for equal and for changing steps (solved to
+    /// round-off).
     WC_INTEGRATOR_IMPLICIT = 2
 } wc_integrator;
 

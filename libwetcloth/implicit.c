@@ -156,6 +156,9 @@ typedef struct implicit_pass {
     const wc_cloth *cloth;
     wc_implicit_state *state;
     double h, pin_fraction;
+    /* the part of the velocity change that the positions take: x+ = x + h
+     * (v0 + share dv), share = (h + h_prev) / 2h (see wc_integrate_implicit) */
+    double share;
     /* dot: a . b; apply, precondition: out = M in; updates: the factor */
     const double *a, *b, *in;
     double *out;
@@ -169,7 +172,7 @@ static void set_block(double *b, double along, double across, double ux, double 
     b[3] = along * uy * uy + across, b[4] = along * uy * uz, b[5] = along * uz * uz + across;
 }
 
-/* Each link's stiffness block K = -df_a/dx_a and B = h^2 K + h C:
+/* Each link's stiffness block K = -df_a/dx_a and B = share h^2 K + h C:
  *   stretch, taut (d > l): K = k [(l/d) u u^T + (1 - l/d) I], positive
  *     definite; slack: none (tension only);
  *   bend, compressed: K = k_b u u^T with k_b the buckling force's slope;
@@ -182,7 +185,7 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
     const implicit_pass *pass = context;
     const wc_cloth *c = pass->cloth;
     wc_implicit_state *s = pass->state;
-    double h = pass->h;
+    double h = pass->h, hh = pass->share * h * h;
     const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
     int32_t ns = st->count;
     const double *v0 = s->v0;
@@ -206,7 +209,7 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
         set_block(blk, along, across, ux, uy, uz);
         wc_sym3_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
                     v0[3 * a + 2] - v0[3 * b + 2], kv);
-        set_block(blk, h * h * along + h * damp, h * h * across, ux, uy, uz);
+        set_block(blk, hh * along + h * damp, hh * across, ux, uy, uz);
         memcpy(s->row_block + 6 * (size_t)s->slot_a[e], blk, 6 * sizeof *blk);
         memcpy(s->row_block + 6 * (size_t)s->slot_b[e], blk, 6 * sizeof *blk);
     }
@@ -236,9 +239,10 @@ static int start_velocities_range(void *context, int64_t begin, int64_t end)
         if (c->pin_slot[i] >= 0) {
             double p[3];
             wc_pinned_position(c, c->pin_slot[i], pin_fraction, p);
-            fx[0] = (p[0] - c->x[i]) / h - v[0];
-            fx[1] = (p[1] - c->y[i]) / h - v[1];
-            fx[2] = (p[2] - c->z[i]) / h - v[2];
+            double share = pass->share;
+            fx[0] = ((p[0] - c->x[i]) / h - v[0]) / share;
+            fx[1] = ((p[1] - c->y[i]) / h - v[1]) / share;
+            fx[2] = ((p[2] - c->z[i]) / h - v[2]) / share;
         }
     }
     return 0;
@@ -478,11 +482,11 @@ static int32_t first_non_finite_rhs(const wc_implicit_state *s)
     return -1;
 }
 
-/* v1 = v0 + dv, x1 = x + h v1; pins exactly at their targets. */
+/* x1 = x + h (v0 + share dv); pins exactly at their targets. */
 typedef struct positions_pass {
     wc_cloth *cloth;
     const wc_implicit_state *state;
-    double dt, pin_fraction;
+    double dt, pin_fraction, share;
 } positions_pass;
 
 static int positions_range(void *context, int64_t begin, int64_t end)
@@ -490,7 +494,7 @@ static int positions_range(void *context, int64_t begin, int64_t end)
     const positions_pass *pass = context;
     wc_cloth *c = pass->cloth;
     const wc_implicit_state *s = pass->state;
-    double dt = pass->dt;
+    double dt = pass->dt, share = pass->share;
     for (int64_t i = begin; i < end; ++i) {
         if (c->pin_slot[i] >= 0) {
             double p[3];
@@ -499,9 +503,9 @@ static int positions_range(void *context, int64_t begin, int64_t end)
             continue;
         }
         const double *v = s->v0 + 3 * (size_t)i, *y = s->y + 3 * (size_t)i;
-        c->nx[i] = c->x[i] + dt * (v[0] + y[0]);
-        c->ny[i] = c->y[i] + dt * (v[1] + y[1]);
-        c->nz[i] = c->z[i] + dt * (v[2] + y[2]);
+        c->nx[i] = c->x[i] + dt * (v[0] + share * y[0]);
+        c->ny[i] = c->y[i] + dt * (v[1] + share * y[1]);
+        c->nz[i] = c->z[i] + dt * (v[2] + share * y[2]);
     }
     return 0;
 }
@@ -512,7 +516,18 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doubl
     wc_implicit_state *s = c->implicit;
     int32_t n = c->particle_count;
     int particle_threads = wc_threads_for(n, threads);
-    implicit_pass pass = {c, s, dt, pin_fraction, NULL, NULL, NULL, NULL, 0.0};
+    /* The start velocity is the last step's chord (x - x_prev) / h_prev,
+     * the velocity half that step back, not at the step's start: moving
+     * the positions by h (v0 + dv) would put the velocity change (h_prev +
+     * h) / 2 too early, and a cloth falling from rest (h_prev = 0, v0 the
+     * velocity set) would lead free fall by g t h / 2 for ever. Positions
+     * take the share (h + h_prev) / 2h of dv, as Verlet takes its
+     * acceleration over (h + h_prev) / 2 (integrate.c), and the stiffness
+     * term of the matrix the same share; with equal steps it is 1, plain
+     * backward Euler. */
+    double h_prev = c->has_history ? c->dt_prev : 0.0;
+    implicit_pass pass = {c, s, dt, pin_fraction, (dt + h_prev) / (2.0 * dt),
+                          NULL, NULL, NULL, NULL, 0.0};
     wc_parallel_for(n, particle_threads, start_velocities_range, &pass);
     wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
     wc_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);
@@ -521,7 +536,7 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doubl
     if (s->multigrid)
         wc_multigrid_update(s->multigrid, s->mass_diag, s->block, c->pin_slot, threads);
     solve(&pass, tolerance * dt, threads);
-    positions_pass positions = {c, s, dt, pin_fraction};
+    positions_pass positions = {c, s, dt, pin_fraction, pass.share};
     wc_parallel_for(n, particle_threads, positions_range, &positions);
     return wc_first_non_finite_xyz(c->nx, c->ny, c->nz, n);
 }

@@ -1,6 +1,7 @@
 /* Semi-implicit backward Euler (WC_INTEGRATOR_IMPLICIT), after Baraff &
  * Witkin 1998 and Choi & Ko 2002: one linear solve per step,
- *   (M - h df/dv - h^2 df/dx) dv = h (f + h df/dx v),
+ *   (M - h df/dv - s h^2 df/dx) dv = h (f + h df/dx v),  x+ = x + h (v + s dv),
+ * s = (h + h_prev) / 2h (1 with equal steps),
  * with df/dx the stretch links' Jacobian (tension only) and the bend
  * links' axial stiffness (their transverse term dropped, as Choi & Ko do,
  * because it would make the matrix indefinite), df/dv the stretch dashpots
@@ -26,8 +27,12 @@ void wc_implicit_state_destroy(wc_implicit_state *state);
 int32_t wc_implicit_last_iterations(const wc_implicit_state *state);
 double wc_implicit_last_residual(const wc_implicit_state *state);
 
-/// Writes the positions after a step of dt into cloth->nx/ny/nz, x + dt v1,
-/// with v1 from the solve above and the forces in cloth->fx/fy/fz. Pinned
+/// Writes the positions after a step of dt into cloth->nx/ny/nz, x + dt (v
+/// + share dv), with v the last step's chord velocity, dv from the solve
+/// above (whose stiffness term takes the same share) and the forces in
+/// cloth->fx/fy/fz; share = (dt + dt_prev) / (2 dt), 1/2 on a first step:
+/// the velocity change acts over the same time as Verlet's acceleration,
+/// which keeps free fall exact. Pinned
 /// particles go where Verlet puts them. The solve stops when its estimated
 /// velocity error is at most tolerance * dt (wc_world_def.implicit_tolerance,
 /// m/s^2; 0: to round-off). Returns the index of the first particle whose
