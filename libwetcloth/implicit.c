@@ -30,12 +30,12 @@
 /* A cap for pathological systems; the step uses the last iterate, which is
  * still a descent toward the solution. */
 #define CG_MAX_ITERATIONS 1000
-/* Dot products sum fixed chunks of this many values, then the chunks in
+/* Dot products sum fixed blocks of this many particles, then the blocks in
  * order: the same rounding for any thread count. */
-#define CHUNK 2048
+#define BLOCK 512
 
 struct wc_implicit_state {
-    int32_t n, links, chunks;
+    int32_t n, links, blocks;
     /// Ends of each link, stretch links first, then bend links.
     int32_t *end_a, *end_b;
     /// Per link: B = h^2 K + h c u u^T as xx, xy, xz, yy, yz, zz, and
@@ -88,7 +88,7 @@ wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
     size_t n = (size_t)c->particle_count, links = (size_t)st->count + (size_t)bd->count;
     s->n = c->particle_count;
     s->links = (int32_t)links;
-    s->chunks = (int32_t)((3 * n + CHUNK - 1) / CHUNK);
+    s->blocks = (int32_t)((n + BLOCK - 1) / BLOCK);
     s->end_a = wc_alloc_array(links, sizeof *s->end_a);
     s->end_b = wc_alloc_array(links, sizeof *s->end_b);
     s->block = wc_alloc_array(6 * links, sizeof(double));
@@ -99,7 +99,7 @@ wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
     int ok = 1;
     for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
         ok &= (*vectors[i] = wc_alloc_array(3 * n, sizeof(double))) != NULL;
-    s->partial = wc_alloc_array((size_t)s->chunks, sizeof(double));
+    s->partial = wc_alloc_array((size_t)s->blocks, sizeof(double));
     size_t entries = (size_t)c->link_start[n];
     s->row_block = wc_alloc_array(6 * entries + 1, sizeof(double));
     s->row_other = wc_alloc_array(entries + 1, sizeof(int32_t));
@@ -289,120 +289,161 @@ static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t en
     return 0;
 }
 
-/* out = A in, A = M + h drag A_i + sum_links B (in_i - in_j), over free
- * particles; in is zero at pins and so is out. */
-static int apply_range(void *context, int64_t begin, int64_t end)
+/* The loops of one CG iteration run over fixed blocks of BLOCK particles,
+ * each block on one thread, and the dot products the iteration needs are
+ * summed inside the loops that make their operands: each block's sum in
+ * particle order into partial[block], then the blocks in order (block_sum).
+ * The same rounding for any thread count, and one pass over the vectors
+ * fewer per dot product. */
+static void block_bounds(const wc_implicit_state *s, int64_t block, int64_t *begin, int64_t *end)
 {
-    const implicit_pass *pass = context;
-    const wc_cloth *c = pass->cloth;
-    const wc_implicit_state *s = pass->state;
-    const double *in = pass->in;
-    double *out = pass->out;
-    for (int64_t i = begin; i < end; ++i) {
-        double *o = out + 3 * (size_t)i;
-        if (c->pin_slot[i] >= 0) {
-            o[0] = o[1] = o[2] = 0.0;
-            continue;
-        }
-        const double *vi = in + 3 * (size_t)i;
-        double md = s->mass_diag[i];
-        double ox = md * vi[0], oy = md * vi[1], oz = md * vi[2];
-        for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
-            const double *vj = in + 3 * (size_t)s->row_other[k];
-            double t[3];
-            wc_sym3_times(s->row_block + 6 * (size_t)k, vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2],
-                        t);
-            ox += t[0], oy += t[1], oz += t[2];
-        }
-        o[0] = ox, o[1] = oy, o[2] = oz;
-    }
-    return 0;
+    *begin = block * BLOCK;
+    *end = *begin + BLOCK < s->n ? *begin + BLOCK : s->n;
 }
 
-static int precondition_range(void *context, int64_t begin, int64_t end)
+static double block_sum(const wc_implicit_state *s)
 {
-    const implicit_pass *pass = context;
-    const double *in = pass->in, *precond = pass->state->precond;
-    double *out = pass->out;
-    for (int64_t i = begin; i < end; ++i)
-        wc_sym3_times(precond + 6 * (size_t)i, in[3 * (size_t)i], in[3 * (size_t)i + 1],
-                    in[3 * (size_t)i + 2], out + 3 * (size_t)i);
-    return 0;
-}
-
-/* out = A in (apply_range) or out = P in (precondition_range) over the
- * particles. */
-static void particle_pass(implicit_pass *pass, wc_range_fn body, const double *in, double *out,
-                          int threads)
-{
-    int32_t n = pass->state->n;
-    pass->in = in, pass->out = out;
-    wc_parallel_for(n, wc_threads_for(n, threads), body, pass);
-}
-
-/* z = the preconditioner applied to r: block-Jacobi, plus the coarse
- * levels' correction on a large cloth. */
-static void precondition(implicit_pass *pass, int threads)
-{
-    wc_implicit_state *s = pass->state;
-    particle_pass(pass, precondition_range, s->r, s->z, threads);
-    if (s->multigrid) wc_multigrid_add_correction(s->multigrid, s->r, s->z, threads);
-}
-
-/* a . b over 3n values, summed in fixed chunks, then the chunks in order. */
-static int dot_range(void *context, int64_t first, int64_t last)
-{
-    const implicit_pass *pass = context;
-    const double *a = pass->a, *b = pass->b;
-    int64_t len = 3 * (int64_t)pass->state->n;
-    for (int64_t k = first; k < last; ++k) {
-        int64_t begin = k * CHUNK, end = begin + CHUNK < len ? begin + CHUNK : len;
-        double sum = 0.0;
-        for (int64_t i = begin; i < end; ++i) sum += a[i] * b[i];
-        pass->state->partial[k] = sum;
-    }
-    return 0;
-}
-
-static double dot(implicit_pass *pass, const double *a, const double *b, int threads)
-{
-    const wc_implicit_state *s = pass->state;
-    pass->a = a, pass->b = b;
-    wc_parallel_for(s->chunks, wc_threads_for(s->n, threads), dot_range, pass);
     double total = 0.0;
-    for (int32_t k = 0; k < s->chunks; ++k) total += s->partial[k];
+    for (int32_t k = 0; k < s->blocks; ++k) total += s->partial[k];
     return total;
 }
 
-/* y += alpha p; r -= alpha q. */
-static int update_solution_range(void *context, int64_t begin, int64_t end)
+/* out = A in, A = M + h drag A_i + sum_links B (in_i - in_j), over free
+ * particles; in is zero at pins and so is out. Sums in . out. */
+static int apply_range(void *context, int64_t first, int64_t last)
+{
+    const implicit_pass *pass = context;
+    const wc_cloth *c = pass->cloth;
+    wc_implicit_state *s = pass->state;
+    const double *in = pass->in;
+    double *out = pass->out;
+    for (int64_t block = first; block < last; ++block) {
+        int64_t begin, end;
+        block_bounds(s, block, &begin, &end);
+        double sum = 0.0;
+        for (int64_t i = begin; i < end; ++i) {
+            double *o = out + 3 * (size_t)i;
+            if (c->pin_slot[i] >= 0) {
+                o[0] = o[1] = o[2] = 0.0;
+                continue;
+            }
+            const double *vi = in + 3 * (size_t)i;
+            double md = s->mass_diag[i];
+            double ox = md * vi[0], oy = md * vi[1], oz = md * vi[2];
+            for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
+                const double *vj = in + 3 * (size_t)s->row_other[k];
+                double t[3];
+                wc_sym3_times(s->row_block + 6 * (size_t)k, vi[0] - vj[0], vi[1] - vj[1],
+                              vi[2] - vj[2], t);
+                ox += t[0], oy += t[1], oz += t[2];
+            }
+            o[0] = ox, o[1] = oy, o[2] = oz;
+            sum += vi[0] * ox;
+            sum += vi[1] * oy;
+            sum += vi[2] * oz;
+        }
+        s->partial[block] = sum;
+    }
+    return 0;
+}
+
+/* z = the block-Jacobi preconditioner times r; sums r . z (of no use when
+ * the coarse levels add to z after). */
+static int precondition_range(void *context, int64_t first, int64_t last)
+{
+    const implicit_pass *pass = context;
+    wc_implicit_state *s = pass->state;
+    const double *r = s->r, *precond = s->precond;
+    double *z = s->z;
+    for (int64_t block = first; block < last; ++block) {
+        int64_t begin, end;
+        block_bounds(s, block, &begin, &end);
+        double sum = 0.0;
+        for (int64_t i = 3 * begin; i < 3 * end; i += 3) {
+            wc_sym3_times(precond + 2 * (size_t)i, r[i], r[i + 1], r[i + 2], z + i);
+            sum += r[i] * z[i];
+            sum += r[i + 1] * z[i + 1];
+            sum += r[i + 2] * z[i + 2];
+        }
+        s->partial[block] = sum;
+    }
+    return 0;
+}
+
+/* a . b over the 3n values. */
+static int dot_range(void *context, int64_t first, int64_t last)
+{
+    const implicit_pass *pass = context;
+    wc_implicit_state *s = pass->state;
+    const double *a = pass->a, *b = pass->b;
+    for (int64_t block = first; block < last; ++block) {
+        int64_t begin, end;
+        block_bounds(s, block, &begin, &end);
+        double sum = 0.0;
+        for (int64_t i = 3 * begin; i < 3 * end; ++i) sum += a[i] * b[i];
+        s->partial[block] = sum;
+    }
+    return 0;
+}
+
+/* y += alpha p; r -= alpha q; sums r . r. */
+static int update_solution_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
     wc_implicit_state *s = pass->state;
     double alpha = pass->factor;
-    for (int64_t i = begin; i < end; ++i) {
-        s->y[i] += alpha * s->p[i];
-        s->r[i] -= alpha * s->q[i];
+    for (int64_t block = first; block < last; ++block) {
+        int64_t begin, end;
+        block_bounds(s, block, &begin, &end);
+        double sum = 0.0;
+        for (int64_t i = 3 * begin; i < 3 * end; ++i) {
+            s->y[i] += alpha * s->p[i];
+            s->r[i] -= alpha * s->q[i];
+            sum += s->r[i] * s->r[i];
+        }
+        s->partial[block] = sum;
     }
     return 0;
 }
 
 /* p = z + beta p. */
-static int update_direction_range(void *context, int64_t begin, int64_t end)
+static int update_direction_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
     wc_implicit_state *s = pass->state;
     double beta = pass->factor;
-    for (int64_t i = begin; i < end; ++i) s->p[i] = s->z[i] + beta * s->p[i];
+    for (int64_t block = first; block < last; ++block) {
+        int64_t begin, end;
+        block_bounds(s, block, &begin, &end);
+        for (int64_t i = 3 * begin; i < 3 * end; ++i) s->p[i] = s->z[i] + beta * s->p[i];
+    }
     return 0;
 }
 
-/* One of the two updates over the 3n values with the given factor. */
-static void vector_update(implicit_pass *pass, wc_range_fn body, double factor, int threads)
+/* One loop of an iteration over the blocks; returns block_sum of what it
+ * summed (meaningless for update_direction_range, which sums nothing). */
+static double block_pass(implicit_pass *pass, wc_range_fn body, int threads)
 {
-    int32_t n = pass->state->n;
-    pass->factor = factor;
-    wc_parallel_for(3 * (int64_t)n, wc_threads_for(n, threads), body, pass);
+    wc_implicit_state *s = pass->state;
+    wc_parallel_for(s->blocks, wc_threads_for(s->n, threads), body, pass);
+    return block_sum(s);
+}
+
+static double dot(implicit_pass *pass, const double *a, const double *b, int threads)
+{
+    pass->a = a, pass->b = b;
+    return block_pass(pass, dot_range, threads);
+}
+
+/* z = the preconditioner applied to r: block-Jacobi, plus the coarse
+ * levels' correction on a large cloth. Returns r . z. */
+static double precondition(implicit_pass *pass, int threads)
+{
+    wc_implicit_state *s = pass->state;
+    double rz = block_pass(pass, precondition_range, threads);
+    if (!s->multigrid) return rz;
+    wc_multigrid_add_correction(s->multigrid, s->r, s->z, threads);
+    return dot(pass, s->r, s->z, threads);
 }
 
 /* The mass the solve's free particles carry, kg: with the step's
@@ -440,9 +481,8 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
     double bb = dot(pass, s->rhs, s->rhs, threads), rr = bb;
     int32_t it = 0;
     if (bb > 0.0) {
-        precondition(pass, threads);
+        double rz = precondition(pass, threads);
         memcpy(s->p, s->z, bytes);
-        double rz = dot(pass, s->r, s->z, threads);
         double bound = velocity_tolerance > 0.0 ? velocity_tolerance * velocity_tolerance *
                                                       free_mass(pass->cloth, s)
                                                 : 0.0;
@@ -450,18 +490,18 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
         for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
             if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
                 break;
-            particle_pass(pass, apply_range, s->p, s->q, threads);
-            double pq = dot(pass, s->p, s->q, threads);
+            pass->in = s->p, pass->out = s->q;
+            double pq = block_pass(pass, apply_range, threads);
             /* A is positive definite, so pq > 0 unless p = 0 or something
              * is not finite: then stop, the caller checks the result */
             if (!(pq > 0.0) || !isfinite(pq)) break;
             double alpha = rz / pq;
             decrease[it % ESTIMATE_DELAY] = alpha * rz;
-            vector_update(pass, update_solution_range, alpha, threads);
-            rr = dot(pass, s->r, s->r, threads);
-            precondition(pass, threads);
-            double rz_next = dot(pass, s->r, s->z, threads);
-            vector_update(pass, update_direction_range, rz_next / rz, threads);
+            pass->factor = alpha;
+            rr = block_pass(pass, update_solution_range, threads);
+            double rz_next = precondition(pass, threads);
+            pass->factor = rz_next / rz;
+            block_pass(pass, update_direction_range, threads);
             rz = rz_next;
         }
     }
