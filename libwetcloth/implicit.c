@@ -38,7 +38,7 @@ struct wc_implicit_state {
     int32_t n, links, blocks;
     /// Ends of each link, stretch links first, then bend links.
     int32_t *end_a, *end_b;
-    /// Per link: B = h^2 K + h c u u^T as xx, xy, xz, yy, yz, zz, and
+    /// Per link: B = share h^2 K + h c u u^T as xx, xy, xz, yy, yz, zz, and
     /// K (v0_a - v0_b), K = -df_a/dx_a.
     double *block, *kv;
     /// Per particle: m + h drag A (the diagonal of M - h df/dv from drag),
