@@ -20,6 +20,13 @@
  * Laplacian-like matrix best. */
 #define SMOOTHING_WEIGHT (2.0 / 3.0)
 #define COARSEST_SWEEPS 4
+/* A level's loops run on the world's threads from this many nodes up (the
+ * fine level's count for the restriction, which reads the fine level), far
+ * below WC_PARALLEL_MIN: every CG iteration runs a dozen of them per level,
+ * back to back with the solve's own parallel loops, and left on one thread
+ * the first coarse level of a 10,201-particle cloth (1,133 nodes) had the
+ * other thread waiting through them. */
+#define LEVEL_PARALLEL_MIN 256
 
 typedef struct level {
     int32_t n, links;
@@ -421,7 +428,7 @@ static void level_loop(level *l, level *c, wc_range_fn body, const double *in, d
                        int64_t count, int threads)
 {
     mg_pass p = {l, c, in, out};
-    wc_parallel_for(count, wc_threads_for(count, threads), body, &p);
+    wc_parallel_for(count, l->n >= LEVEL_PARALLEL_MIN ? threads : 1, body, &p);
 }
 
 static void residual(level *l, int threads)
