@@ -159,7 +159,7 @@ typedef struct implicit_pass {
     /* the part of the velocity change that the positions take: x+ = x + h
      * (v0 + share dv), share = (h + h_prev) / 2h (see wc_integrate_implicit) */
     double share;
-    /* dot: a . b; apply, precondition: out = M in; updates: the factor */
+    /* dot: a . b; apply: out = A in; updates: the factor */
     const double *a, *b, *in;
     double *out;
     double factor;
@@ -420,19 +420,24 @@ static int update_direction_range(void *context, int64_t first, int64_t last)
     return 0;
 }
 
-/* One loop of an iteration over the blocks; returns block_sum of what it
- * summed (meaningless for update_direction_range, which sums nothing). */
-static double block_pass(implicit_pass *pass, wc_range_fn body, int threads)
+/* One loop of an iteration over the blocks. */
+static void run_blocks(implicit_pass *pass, wc_range_fn body, int threads)
 {
     wc_implicit_state *s = pass->state;
     wc_parallel_for(s->blocks, wc_threads_for(s->n, threads), body, pass);
-    return block_sum(s);
+}
+
+/* The same for a loop that sums into partial[]: returns the sum. */
+static double summed_blocks(implicit_pass *pass, wc_range_fn body, int threads)
+{
+    run_blocks(pass, body, threads);
+    return block_sum(pass->state);
 }
 
 static double dot(implicit_pass *pass, const double *a, const double *b, int threads)
 {
     pass->a = a, pass->b = b;
-    return block_pass(pass, dot_range, threads);
+    return summed_blocks(pass, dot_range, threads);
 }
 
 /* z = the preconditioner applied to r: block-Jacobi, plus the coarse
@@ -440,7 +445,7 @@ static double dot(implicit_pass *pass, const double *a, const double *b, int thr
 static double precondition(implicit_pass *pass, int threads)
 {
     wc_implicit_state *s = pass->state;
-    double rz = block_pass(pass, precondition_range, threads);
+    double rz = summed_blocks(pass, precondition_range, threads);
     if (!s->multigrid) return rz;
     wc_multigrid_add_correction(s->multigrid, s->r, s->z, threads);
     return dot(pass, s->r, s->z, threads);
@@ -491,17 +496,17 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
             if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
                 break;
             pass->in = s->p, pass->out = s->q;
-            double pq = block_pass(pass, apply_range, threads);
+            double pq = summed_blocks(pass, apply_range, threads);
             /* A is positive definite, so pq > 0 unless p = 0 or something
              * is not finite: then stop, the caller checks the result */
             if (!(pq > 0.0) || !isfinite(pq)) break;
             double alpha = rz / pq;
             decrease[it % ESTIMATE_DELAY] = alpha * rz;
             pass->factor = alpha;
-            rr = block_pass(pass, update_solution_range, threads);
+            rr = summed_blocks(pass, update_solution_range, threads);
             double rz_next = precondition(pass, threads);
             pass->factor = rz_next / rz;
-            block_pass(pass, update_direction_range, threads);
+            run_blocks(pass, update_direction_range, threads);
             rz = rz_next;
         }
     }
