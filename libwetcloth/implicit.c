@@ -49,14 +49,8 @@ struct wc_implicit_state {
     /// search direction, matrix times direction.
     double *v0, *fixed, *rhs, *y, *r, *z, *p, *q;
     double *partial;
-    /// The link blocks again, row by row: entry k of the cloth's link list
-    /// (c->link_start, c->link_list) holds its link's block and the particle
-    /// at the link's other end, and each link's entries in the rows of its
-    /// first and second end are slot_a and slot_b. The product with the
-    /// matrix, run once or more per iteration, then reads each row's blocks
-    /// in one sweep instead of gathering them by link.
-    double *row_block;
-    int32_t *row_other, *slot_a, *slot_b;
+    /// Per link, scratch of the product with the matrix: B (in_a - in_b).
+    double *link_product;
     /// The preconditioner's coarse levels; NULL for a cloth too small to
     /// gain from them (multigrid.h).
     wc_multigrid *multigrid;
@@ -68,14 +62,10 @@ void wc_implicit_state_destroy(wc_implicit_state *s)
 {
     if (!s) return;
     double *arrays[] = {s->block, s->kv, s->mass_diag, s->precond, s->v0, s->fixed, s->rhs,
-                        s->y, s->r, s->z, s->p, s->q, s->partial};
+                        s->y, s->r, s->z, s->p, s->q, s->partial, s->link_product};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
     wc_free(s->end_a);
     wc_free(s->end_b);
-    wc_free(s->row_block);
-    wc_free(s->row_other);
-    wc_free(s->slot_a);
-    wc_free(s->slot_b);
     wc_multigrid_destroy(s->multigrid);
     wc_free(s);
 }
@@ -100,24 +90,15 @@ wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
     for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
         ok &= (*vectors[i] = wc_alloc_array(3 * n, sizeof(double))) != NULL;
     s->partial = wc_alloc_array((size_t)s->blocks, sizeof(double));
-    size_t entries = (size_t)c->link_start[n];
-    s->row_block = wc_alloc_array(6 * entries + 1, sizeof(double));
-    s->row_other = wc_alloc_array(entries + 1, sizeof(int32_t));
-    s->slot_a = wc_alloc_array(links + 1, sizeof(int32_t));
-    s->slot_b = wc_alloc_array(links + 1, sizeof(int32_t));
+    s->link_product = wc_alloc_array(3 * links + 1, sizeof(double));
     if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
-        !s->partial || !s->row_block || !s->row_other || !s->slot_a || !s->slot_b) {
+        !s->partial || !s->link_product) {
         wc_implicit_state_destroy(s);
         return NULL;
     }
     for (int32_t e = 0; e < st->count; ++e) s->end_a[e] = st->a[e], s->end_b[e] = st->b[e];
     for (int32_t e = 0; e < bd->count; ++e)
         s->end_a[st->count + e] = bd->a[e], s->end_b[st->count + e] = bd->b[e];
-    for (size_t k = 0; k < entries; ++k) {
-        int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
-        if (entry >= 0) s->slot_a[e] = (int32_t)k, s->row_other[k] = s->end_b[e];
-        else s->slot_b[e] = (int32_t)k, s->row_other[k] = s->end_a[e];
-    }
     if (wc_multigrid_create(s->n, s->links, s->end_a, s->end_b, st->count, c->link_start,
                             c->link_list, &s->multigrid)) {
         wc_implicit_state_destroy(s);
@@ -210,8 +191,6 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
         wc_sym3_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
                     v0[3 * a + 2] - v0[3 * b + 2], kv);
         set_block(blk, hh * along + h * damp, hh * across, ux, uy, uz);
-        memcpy(s->row_block + 6 * (size_t)s->slot_a[e], blk, 6 * sizeof *blk);
-        memcpy(s->row_block + 6 * (size_t)s->slot_b[e], blk, 6 * sizeof *blk);
     }
     return 0;
 }
@@ -308,8 +287,26 @@ static double block_sum(const wc_implicit_state *s)
     return total;
 }
 
-/* out = A in, A = M + h drag A_i + sum_links B (in_i - in_j), over free
- * particles; in is zero at pins and so is out. Sums in . out. */
+/* The product's first pass, per link: B (in_a - in_b). Each link's block
+ * is applied once, not once from each end's row: half the arithmetic of
+ * the product, which is most of an iteration. */
+static int link_products_range(void *context, int64_t begin, int64_t end)
+{
+    const implicit_pass *pass = context;
+    wc_implicit_state *s = pass->state;
+    const double *in = pass->in;
+    for (int64_t e = begin; e < end; ++e) {
+        const double *va = in + 3 * (size_t)s->end_a[e], *vb = in + 3 * (size_t)s->end_b[e];
+        wc_sym3_times(s->block + 6 * (size_t)e, va[0] - vb[0], va[1] - vb[1], va[2] - vb[2],
+                      s->link_product + 3 * (size_t)e);
+    }
+    return 0;
+}
+
+/* Its second pass: out = A in, A = M + h drag A_i + sum_links B (in_i -
+ * in_j), over free particles, gathered per row in the link list's order;
+ * a row's second-end links subtract, B (in_b - in_a) being exactly -B
+ * (in_a - in_b). in is zero at pins and so is out. Sums in . out. */
 static int apply_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
@@ -331,11 +328,14 @@ static int apply_range(void *context, int64_t first, int64_t last)
             double md = s->mass_diag[i];
             double ox = md * vi[0], oy = md * vi[1], oz = md * vi[2];
             for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
-                const double *vj = in + 3 * (size_t)s->row_other[k];
-                double t[3];
-                wc_sym3_times(s->row_block + 6 * (size_t)k, vi[0] - vj[0], vi[1] - vj[1],
-                              vi[2] - vj[2], t);
-                ox += t[0], oy += t[1], oz += t[2];
+                int32_t entry = c->link_list[k];
+                if (entry >= 0) {
+                    const double *t = s->link_product + 3 * (size_t)entry;
+                    ox += t[0], oy += t[1], oz += t[2];
+                } else {
+                    const double *t = s->link_product + 3 * (size_t)~entry;
+                    ox -= t[0], oy -= t[1], oz -= t[2];
+                }
             }
             o[0] = ox, o[1] = oy, o[2] = oz;
             sum += vi[0] * ox;
@@ -496,6 +496,7 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
             if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
                 break;
             pass->in = s->p, pass->out = s->q;
+            wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_products_range, pass);
             double pq = summed_blocks(pass, apply_range, threads);
             /* A is positive definite, so pq > 0 unless p = 0 or something
              * is not finite: then stop, the caller checks the result */
