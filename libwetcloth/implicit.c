@@ -144,6 +144,10 @@ typedef struct implicit_pass {
     const double *a, *b, *in;
     double *out;
     double factor;
+    /* precondition: the coarse levels' solution per aggregate and each
+     * particle's aggregate, NULL without coarse levels */
+    const double *coarse;
+    const int32_t *aggregate;
 } implicit_pass;
 
 static void set_block(double *b, double along, double across, double ux, double uy, double uz)
@@ -347,23 +351,32 @@ static int apply_range(void *context, int64_t first, int64_t last)
     return 0;
 }
 
-/* z = the block-Jacobi preconditioner times r; sums r . z (of no use when
- * the coarse levels add to z after). */
+/* z = the preconditioner times r: the block-Jacobi step, plus on a large
+ * cloth the coarse levels' correction of each free particle's aggregate
+ * (solved before this pass: wc_multigrid_coarse_solve). Sums r . z. One
+ * pass for the three, so that r and z are read once per iteration. */
 static int precondition_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
     wc_implicit_state *s = pass->state;
-    const double *r = s->r, *precond = s->precond;
+    const double *r = s->r, *precond = s->precond, *coarse = pass->coarse;
+    const int32_t *aggregate = pass->aggregate, *pin_slot = pass->cloth->pin_slot;
     double *z = s->z;
     for (int64_t block = first; block < last; ++block) {
         int64_t begin, end;
         block_bounds(s, block, &begin, &end);
         double sum = 0.0;
-        for (int64_t i = 3 * begin; i < 3 * end; i += 3) {
-            wc_sym3_times(precond + 2 * (size_t)i, r[i], r[i + 1], r[i + 2], z + i);
-            sum += r[i] * z[i];
-            sum += r[i + 1] * z[i + 1];
-            sum += r[i + 2] * z[i + 2];
+        for (int64_t i = begin; i < end; ++i) {
+            double *zi = z + 3 * (size_t)i;
+            const double *ri = r + 3 * (size_t)i;
+            wc_sym3_times(precond + 6 * (size_t)i, ri[0], ri[1], ri[2], zi);
+            if (coarse && pin_slot[i] < 0) {
+                const double *xc = coarse + 3 * (size_t)aggregate[i];
+                zi[0] += xc[0], zi[1] += xc[1], zi[2] += xc[2];
+            }
+            sum += ri[0] * zi[0];
+            sum += ri[1] * zi[1];
+            sum += ri[2] * zi[2];
         }
         s->partial[block] = sum;
     }
@@ -445,10 +458,12 @@ static double dot(implicit_pass *pass, const double *a, const double *b, int thr
 static double precondition(implicit_pass *pass, int threads)
 {
     wc_implicit_state *s = pass->state;
-    double rz = summed_blocks(pass, precondition_range, threads);
-    if (!s->multigrid) return rz;
-    wc_multigrid_add_correction(s->multigrid, s->r, s->z, threads);
-    return dot(pass, s->r, s->z, threads);
+    if (s->multigrid) {
+        wc_multigrid_coarse_solve(s->multigrid, s->r, threads);
+        pass->coarse = wc_multigrid_coarse_solution(s->multigrid);
+        pass->aggregate = wc_multigrid_fine_aggregates(s->multigrid);
+    }
+    return summed_blocks(pass, precondition_range, threads);
 }
 
 /* The mass the solve's free particles carry, kg: with the step's
@@ -573,7 +588,7 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doubl
      * backward Euler. */
     double h_prev = c->has_history ? c->dt_prev : 0.0;
     implicit_pass pass = {c, s, dt, pin_fraction, (dt + h_prev) / (2.0 * dt),
-                          NULL, NULL, NULL, NULL, 0.0};
+                          NULL, NULL, NULL, NULL, 0.0, NULL, NULL};
     wc_parallel_for(n, particle_threads, start_velocities_range, &pass);
     wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
     wc_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);

@@ -493,12 +493,21 @@ static void cycle(wc_multigrid *mg, int32_t k, int threads)
     smooth(l, 0, threads);
 }
 
-void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
+void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads)
 {
     level *fine = &mg->level[0], *c = &mg->level[1];
     level_loop(fine, c, restrict_range, r, c->b, c->n, threads);
     cycle(mg, 1, threads);
-    level_loop(fine, c, prolong_range, NULL, z, fine->n, threads);
+}
+
+const double *wc_multigrid_coarse_solution(const wc_multigrid *mg) { return mg->level[1].x; }
+
+const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg) { return mg->level[0].agg; }
+
+void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
+{
+    wc_multigrid_coarse_solve(mg, r, threads);
+    level_loop(&mg->level[0], &mg->level[1], prolong_range, NULL, z, mg->level[0].n, threads);
 }
 
 int32_t wc_multigrid_level_size(const wc_multigrid *mg, int32_t k) { return mg->level[k].n; }

@@ -71,6 +71,15 @@ void wc_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double
 /// zero at pins and z is left unchanged there.
 void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads);
 
+/// The same in two halves, for a caller that adds the correction in a pass
+/// of its own over the fine nodes (implicit.c, with its block-Jacobi step
+/// and a dot product): C P^T r, 3 values per aggregate of the finest
+/// level, valid until the next call; a free fine node i adds entry
+/// aggregates[i] of it (P), a pinned node nothing.
+void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads);
+const double *wc_multigrid_coarse_solution(const wc_multigrid *mg);
+const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg);
+
 /* For tests (tests/test_multigrid.c): a level's node count, the aggregate
  * (node of level + 1) of one of its nodes, and the product with a coarse
  * level's matrix, out = A in (level >= 1, after an update). */
