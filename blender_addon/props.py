@@ -164,11 +164,11 @@ class WetClothSettings(bpy.types.PropertyGroup):
         default="VERLET",
         description="How a step advances the cloth (docs/model.md, Integrators)")
     implicit_tolerance: FloatProperty(
-        name="Solver Tolerance", default=0.5, min=0.0, max=1000.0, soft_max=5.0,
+        name="Solver Tolerance", default=1.0, min=0.0, max=1000.0, soft_max=5.0,
         precision=3,
         description="Semi-Implicit only: how exactly each step's linear system is solved, as a "
                     "stray acceleration the solve may leave, m/s² (0 solves to round-off). "
-                    "Larger is faster; above about 1 a very stiff cloth can gain energy")
+                    "Larger is faster; from about 2 a very stiff cloth can gain energy")
     substeps_auto: BoolProperty(
         name="Automatic Substeps", default=True,
         description="Choose the steps per frame from the library's stable step")

@@ -121,10 +121,11 @@ typedef struct wc_world_def {
     /// times the step: the solve's error then acts like a stray acceleration
     /// of at most this size over one step. 0 solves to round-off (residual
     /// 1e-8 of the right-hand side, which also ends every solve). Default
-    /// 0.5 (about g / 20): on the thesis drape it leaves the error against a
-    /// fine-step reference solved to round-off where it was, at 2-4x fewer
-    /// iterations; larger values are faster still but let a near-
-    /// inextensible cloth gain energy (docs/model.md has the figures).
+    /// 1 (about g / 10): on the thesis drape it leaves the error against a
+    /// fine-step reference solved to round-off where it was, at 3-5x fewer
+    /// iterations; it is half the smallest value at which a near-
+    /// inextensible cloth gained energy (2; docs/model.md has the figures),
+    /// so larger values are faster still but may.
     double implicit_tolerance;
 } wc_world_def;
 

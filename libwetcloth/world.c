@@ -36,7 +36,7 @@ wc_world_def wc_world_def_default(void)
     d.integrator = WC_INTEGRATOR_VERLET;
     d.substep_safety = 0.9;
     d.max_substeps = 100000;
-    d.implicit_tolerance = 0.5;
+    d.implicit_tolerance = 1.0;
     return d;
 }
 

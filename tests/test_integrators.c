@@ -638,11 +638,11 @@ static void tolerance_step(int N, double tolerance, double *error, int64_t *loos
 
 static void tolerance(void)
 {
-    CHECK(wc_world_def_default().implicit_tolerance == 0.5, "default tolerance %g",
+    CHECK(wc_world_def_default().implicit_tolerance == 1.0, "default tolerance %g",
           wc_world_def_default().implicit_tolerance);
-    const double tolerances[4] = {0.01, 0.5, 10.0, 0.5};
-    const int sizes[4] = {20, 20, 20, TOLERANCE_N_MAX};
-    for (int k = 0; k < 4; ++k) {
+    const double tolerances[5] = {0.01, 0.5, 1.0, 10.0, 1.0};
+    const int sizes[5] = {20, 20, 20, 20, TOLERANCE_N_MAX};
+    for (int k = 0; k < 5; ++k) {
         double error;
         int64_t loose, exact;
         tolerance_step(sizes[k], tolerances[k], &error, &loose, &exact);

@@ -13,7 +13,7 @@
  *                        fewest it is stable at)
  *     target=0.01        error bound of the summary
  *     stop=1             stop a sweep at the first setting within target
- *     tolerance=0.5      the implicit integrator's solve tolerance, m/s^2
+ *     tolerance=1        the implicit integrator's solve tolerance, m/s^2
  *                        (wc_world_def.implicit_tolerance; default the
  *                        library's); its references at 8x the steps always
  *                        solve to round-off (tolerance 0), so the error
