@@ -122,7 +122,7 @@ typedef struct wc_world_def {
     /// of at most this size over one step. 0 solves to round-off (residual
     /// 1e-8 of the right-hand side, which also ends every solve). Default
     /// 1 (about g / 10): on the thesis drape it leaves the error against a
-    /// fine-step reference solved to round-off where it was, at 3-5x fewer
+    /// fine-step reference solved to round-off where it was, at about 4x fewer
     /// iterations; it is half the smallest value at which a near-
     /// inextensible cloth gained energy (2; docs/model.md has the figures),
     /// so larger values are faster still but may.
