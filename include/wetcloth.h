@@ -44,6 +44,14 @@ extern "C" {
 WC_API int32_t wc_version(void);
 /// Library version as "major.minor.patch".
 WC_API const char *wc_version_string(void);
+/// Size in bytes of the public struct named `name` (its typedef name, e.g.
+/// "wc_world_def") as this library was compiled; 0 for NULL or a name it
+/// does not know. A binding that declares the structs itself (the Python
+/// package's cffi description, generated from this header) compares its
+/// sizes with these when it loads the library: a library and a binding
+/// built from different versions of this header then fail with a message
+/// instead of reading and writing past the end of a struct.
+WC_API int64_t wc_struct_size(const char *name);
 
 /// Result of every call that can fail. On anything but WC_OK the call changed
 /// nothing, and wc_world_last_error() (or the wc_message of wc_world_create)

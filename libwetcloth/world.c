@@ -27,6 +27,30 @@ const char *wc_version_string(void)
     return WC_STR(WC_VERSION_MAJOR) "." WC_STR(WC_VERSION_MINOR) "." WC_STR(WC_VERSION_PATCH);
 }
 
+int64_t wc_struct_size(const char *name)
+{
+    static const struct {
+        const char *name;
+        size_t size;
+    } structs[] = {
+        {"wc_message", sizeof(wc_message)},
+        {"wc_world_def", sizeof(wc_world_def)},
+        {"wc_material", sizeof(wc_material)},
+        {"wc_mesh_cloth_def", sizeof(wc_mesh_cloth_def)},
+        {"wc_grid_cloth_def", sizeof(wc_grid_cloth_def)},
+        {"wc_cloth_view", sizeof(wc_cloth_view)},
+        {"wc_energy", sizeof(wc_energy)},
+        {"wc_mesh_collider_def", sizeof(wc_mesh_collider_def)},
+        {"wc_convex_collider_def", sizeof(wc_convex_collider_def)},
+        {"wc_step_stats", sizeof(wc_step_stats)},
+        {"wc_intersection_counts", sizeof(wc_intersection_counts)},
+    };
+    if (!name) return 0;
+    for (size_t k = 0; k < sizeof structs / sizeof structs[0]; ++k)
+        if (!strcmp(name, structs[k].name)) return (int64_t)structs[k].size;
+    return 0;
+}
+
 wc_world_def wc_world_def_default(void)
 {
     wc_world_def d;

@@ -133,6 +133,36 @@ static void test_null_world(void)
     wc_world_destroy(NULL);
 }
 
+/* wc_struct_size: what a binding compares its struct layouts against. Every
+ * struct with a body in wetcloth.h is listed (the Python binding's test
+ * checks all of those it declares); unknown names and NULL give 0. */
+static void test_struct_sizes(void)
+{
+    const struct {
+        const char *name;
+        size_t size;
+    } known[] = {
+        {"wc_message", sizeof(wc_message)},
+        {"wc_world_def", sizeof(wc_world_def)},
+        {"wc_material", sizeof(wc_material)},
+        {"wc_mesh_cloth_def", sizeof(wc_mesh_cloth_def)},
+        {"wc_grid_cloth_def", sizeof(wc_grid_cloth_def)},
+        {"wc_cloth_view", sizeof(wc_cloth_view)},
+        {"wc_energy", sizeof(wc_energy)},
+        {"wc_mesh_collider_def", sizeof(wc_mesh_collider_def)},
+        {"wc_convex_collider_def", sizeof(wc_convex_collider_def)},
+        {"wc_step_stats", sizeof(wc_step_stats)},
+        {"wc_intersection_counts", sizeof(wc_intersection_counts)},
+    };
+    for (size_t k = 0; k < sizeof known / sizeof known[0]; ++k)
+        CHECK(wc_struct_size(known[k].name) == (int64_t)known[k].size, "%s: %lld, sizeof %zu",
+              known[k].name, (long long)wc_struct_size(known[k].name), known[k].size);
+    CHECK(wc_struct_size(NULL) == 0, "NULL name");
+    CHECK(wc_struct_size("wc_world") == 0, "an opaque handle has no size");
+    CHECK(wc_struct_size("wc_world_def ") == 0, "a name must match exactly");
+    CHECK(wc_struct_size("") == 0, "empty name");
+}
+
 static void test_null_arguments(void)
 {
     int32_t id = -1;
@@ -557,6 +587,7 @@ int main(void)
     check_twins("creation");
     test_world_def();
     test_null_world();
+    test_struct_sizes();
     test_null_arguments();
     test_material();
     test_grid_def();

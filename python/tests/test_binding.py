@@ -65,6 +65,42 @@ def test_environment_override_to_a_missing_file_is_an_error(tmp_path):
     assert "WETCLOTH_LIBRARY" in r.stderr and "nothing.so" in r.stderr
 
 
+def test_every_struct_of_the_binding_has_the_libraries_size():
+    from wetcloth import _lib
+    structs = _lib.declared_structs(wetcloth.ffi)
+    names = [name for name, _ in structs]
+    # the header's 11 structs with a body; wc_world is opaque
+    assert len(structs) == 11 and "wc_world_def" in names and "wc_world" not in names
+    for name, size in structs:
+        assert wetcloth.lib.wc_struct_size(name.encode()) == size, name
+    _lib.check_struct_sizes(wetcloth.lib, wetcloth.ffi, "here")  # raises on a mismatch
+
+
+def test_a_binding_from_another_header_is_refused_by_name():
+    """A binding whose structs differ from the library's (generated from an
+    older or newer wetcloth.h) is refused when it loads, naming each struct
+    and both sizes, instead of passing the library a struct too short."""
+    import cffi
+    from wetcloth import _lib
+    stale = cffi.FFI()
+    stale.cdef("typedef struct wc_world wc_world;"
+               "typedef struct wc_world_def { double gravity[3]; } wc_world_def;"
+               "typedef struct wc_from_the_future { int a; } wc_from_the_future;")
+    with pytest.raises(ImportError) as e:
+        _lib.check_struct_sizes(wetcloth.lib, stale, "/some/libwetcloth.so")
+    text = str(e.value)
+    assert "/some/libwetcloth.so" in text and "different versions of wetcloth.h" in text
+    size = wetcloth.ffi.sizeof("wc_world_def")
+    assert "wc_world_def is %d bytes in the library, 24 in the binding" % size in text
+    assert "wc_from_the_future is not a struct the library knows" in text
+    assert "pip install ." in text
+
+    class OldLibrary:  # a library from before wc_struct_size
+        pass
+    with pytest.raises(ImportError, match="has no wc_struct_size"):
+        _lib.check_struct_sizes(OldLibrary(), wetcloth.ffi, "/old/libwetcloth.so")
+
+
 # ---------------------------------------------------------------------------
 # Material
 

@@ -15,6 +15,9 @@ from ._ffi import ffi
 
 ENV_VAR = "WETCLOTH_LIBRARY"
 LIBRARY_NAMES = ("libwetcloth.so", "libwetcloth.dylib", "wetcloth.dll")
+REINSTALL = ("Install the package and its library together ('pip install .' at the repository "
+             "root, or scripts/setup.sh), or point %s at the library built with this "
+             "binding" % ENV_VAR)
 
 
 def find_library(package_path):
@@ -53,4 +56,46 @@ def load(package_path):
             "%s is libwetcloth %s, but this binding was generated from the %d.%d header; "
             "0.x versions must match in major and minor" %
             (path, ffi.string(lib.wc_version_string()).decode(), major, minor))
+    check_struct_sizes(lib, ffi, path)
     return lib, path
+
+
+def declared_structs(ffi):
+    """(typedef name, size) of each struct with a body that ffi declares;
+    opaque handles (wc_world) and function types have no layout."""
+    # cffi raises ValueError for an incomplete type's size, and ffi.error
+    # (a class of the generated module's ffi only) for a function type
+    no_layout = (ValueError, TypeError) + ((ffi.error,) if hasattr(ffi, "error") else ())
+    found = []
+    for name in sorted(ffi.list_types()[0]):
+        try:
+            if ffi.typeof(name).kind == "struct":
+                found.append((name, ffi.sizeof(name)))
+        except no_layout:
+            continue
+    return found
+
+
+def check_struct_sizes(lib, ffi, path):
+    """Raises ImportError unless every struct this binding declares has
+    the size the library was compiled with (wc_struct_size). The version
+    check alone misses a header changed within a 0.x version: a binding
+    generated from an older wetcloth.h than its library's would pass
+    structs too short for the library, which reads and writes past them."""
+    try:
+        struct_size = lib.wc_struct_size
+    except AttributeError:
+        raise ImportError(
+            "%s has no wc_struct_size: it was built from an older wetcloth.h than this "
+            "binding. %s" % (path, REINSTALL)) from None
+    wrong = []
+    for name, ours in declared_structs(ffi):
+        theirs = struct_size(name.encode())
+        if theirs != ours:
+            wrong.append("%s is %d bytes in the library, %d in the binding" % (
+                name, theirs, ours) if theirs else
+                "%s is not a struct the library knows" % name)
+    if wrong:
+        raise ImportError(
+            "%s and this binding were built from different versions of wetcloth.h: %s. "
+            "%s" % (path, "; ".join(wrong), REINSTALL))
