@@ -95,10 +95,12 @@ def test_a_binding_from_another_header_is_refused_by_name():
     assert "wc_from_the_future is not a struct the library knows" in text
     assert "pip install ." in text
 
-    class OldLibrary:  # a library from before wc_struct_size
-        pass
+    # a library from before wc_struct_size, loaded as the package loads one
+    # (libc stands in: it has no wc_ symbols either)
+    import ctypes.util
+    old = wetcloth.ffi.dlopen(ctypes.util.find_library("c"))
     with pytest.raises(ImportError, match="has no wc_struct_size"):
-        _lib.check_struct_sizes(OldLibrary(), wetcloth.ffi, "/old/libwetcloth.so")
+        _lib.check_struct_sizes(old, wetcloth.ffi, "/old/libwetcloth.so")
 
 
 # ---------------------------------------------------------------------------

@@ -60,36 +60,37 @@ def load(package_path):
     return lib, path
 
 
-def declared_structs(ffi):
-    """(typedef name, size) of each struct with a body that ffi declares;
-    opaque handles (wc_world) and function types have no layout."""
+def declared_structs(binding):
+    """(typedef name, size) of each struct with a body that the cffi FFI
+    `binding` declares; opaque handles (wc_world) and function types have
+    no layout."""
     # cffi raises ValueError for an incomplete type's size, and ffi.error
-    # (a class of the generated module's ffi only) for a function type
-    no_layout = (ValueError, TypeError) + ((ffi.error,) if hasattr(ffi, "error") else ())
+    # (a class of a generated module's ffi only) for a function type
+    no_layout = (ValueError, TypeError) + ((binding.error,) if hasattr(binding, "error") else ())
     found = []
-    for name in sorted(ffi.list_types()[0]):
+    for name in sorted(binding.list_types()[0]):
         try:
-            if ffi.typeof(name).kind == "struct":
-                found.append((name, ffi.sizeof(name)))
+            if binding.typeof(name).kind == "struct":
+                found.append((name, binding.sizeof(name)))
         except no_layout:
             continue
     return found
 
 
-def check_struct_sizes(lib, ffi, path):
-    """Raises ImportError unless every struct this binding declares has
+def check_struct_sizes(lib, binding, path):
+    """Raises ImportError unless every struct `binding` declares has
     the size the library was compiled with (wc_struct_size). The version
     check alone misses a header changed within a 0.x version: a binding
     generated from an older wetcloth.h than its library's would pass
     structs too short for the library, which reads and writes past them."""
     try:
         struct_size = lib.wc_struct_size
-    except AttributeError:
+    except (AttributeError, ffi.error):  # this package's ffi raises its error
         raise ImportError(
             "%s has no wc_struct_size: it was built from an older wetcloth.h than this "
             "binding. %s" % (path, REINSTALL)) from None
     wrong = []
-    for name, ours in declared_structs(ffi):
+    for name, ours in declared_structs(binding):
         theirs = struct_size(name.encode())
         if theirs != ours:
             wrong.append("%s is %d bytes in the library, %d in the binding" % (
