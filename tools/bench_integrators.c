@@ -219,7 +219,31 @@ static best sweep(const options *o, int size, int self, int integrator, const ru
     return b;
 }
 
-static int parse_list(const char *text, int *out, int is_integrator)
+/* A number option's value, or exit 2 naming the option: atof would take
+ * "1e" or "abc" as 0 and run a benchmark nobody asked for. */
+static double number(const char *key, const char *text)
+{
+    char *end;
+    double v = strtod(text, &end);
+    if (end == text || *end || !isfinite(v)) {
+        fprintf(stderr, "%s: expected a number, found '%s'\n", key, text);
+        exit(2);
+    }
+    return v;
+}
+
+static int integer(const char *key, const char *text)
+{
+    char *end;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end || v < 0 || v > 1000000) {
+        fprintf(stderr, "%s: expected a whole number in [0, 1000000], found '%s'\n", key, text);
+        exit(2);
+    }
+    return (int)v;
+}
+
+static int parse_list(const char *key, const char *text, int *out, int is_integrator)
 {
     int count = 0;
     char buf[512];
@@ -229,12 +253,12 @@ static int parse_list(const char *text, int *out, int is_integrator)
             int k = 0;
             while (k < 3 && strcmp(tok, NAMES[k])) ++k;
             if (k == 3) {
-                fprintf(stderr, "integrators: unknown integrator '%s'\n", tok);
+                fprintf(stderr, "%s: unknown integrator '%s'\n", key, tok);
                 exit(2);
             }
             out[count++] = k;
         } else {
-            out[count++] = atoi(tok);
+            out[count++] = integer(key, tok);
         }
     }
     return count;
@@ -246,29 +270,29 @@ static options parse(int argc, char **argv)
     memset(&o, 0, sizeof o);
     o.seconds = 0.5, o.threads = 1, o.target = 0.01, o.stop = 1, o.reference = 1;
     o.tolerance = wc_world_def_default().implicit_tolerance;
-    o.size_count = parse_list("20,101", o.sizes, 0);
-    o.self_count = parse_list("0,1", o.selfs, 0);
-    o.integrator_count = parse_list("verlet,xpbd,implicit", o.integrators, 1);
-    o.step_count = parse_list("2,3,5,8,12,20,30,50", o.steps, 0);
+    o.size_count = parse_list("sizes", "20,101", o.sizes, 0);
+    o.self_count = parse_list("self", "0,1", o.selfs, 0);
+    o.integrator_count = parse_list("integrators", "verlet,xpbd,implicit", o.integrators, 1);
+    o.step_count = parse_list("steps", "2,3,5,8,12,20,30,50", o.steps, 0);
     for (int i = 1; i < argc; ++i) {
         const char *eq = strchr(argv[i], '=');
         if (!eq) {
             fprintf(stderr, "arguments are key=value (see tools/bench_integrators.c): %s\n", argv[i]);
             exit(2);
         }
-        size_t len = (size_t)(eq - argv[i]);
+        char key[32];
+        snprintf(key, sizeof key, "%.*s", (int)(eq - argv[i]), argv[i]);
         const char *v = eq + 1;
-        if (!strncmp(argv[i], "seconds", len)) o.seconds = atof(v);
-        else if (!strncmp(argv[i], "threads", len)) o.threads = atoi(v);
-        else if (!strncmp(argv[i], "target", len)) o.target = atof(v);
-        else if (!strncmp(argv[i], "stop", len)) o.stop = atoi(v);
-        else if (!strncmp(argv[i], "reference", len)) o.reference = atoi(v);
-        else if (!strncmp(argv[i], "tolerance", len)) o.tolerance = atof(v);
-        else if (!strncmp(argv[i], "sizes", len)) o.size_count = parse_list(v, o.sizes, 0);
-        else if (!strncmp(argv[i], "self", len)) o.self_count = parse_list(v, o.selfs, 0);
-        else if (!strncmp(argv[i], "integrators", len))
-            o.integrator_count = parse_list(v, o.integrators, 1);
-        else if (!strncmp(argv[i], "steps", len)) o.step_count = parse_list(v, o.steps, 0);
+        if (!strcmp(key, "seconds")) o.seconds = number(key, v);
+        else if (!strcmp(key, "threads")) o.threads = integer(key, v);
+        else if (!strcmp(key, "target")) o.target = number(key, v);
+        else if (!strcmp(key, "stop")) o.stop = integer(key, v);
+        else if (!strcmp(key, "reference")) o.reference = integer(key, v);
+        else if (!strcmp(key, "tolerance")) o.tolerance = number(key, v);
+        else if (!strcmp(key, "sizes")) o.size_count = parse_list(key, v, o.sizes, 0);
+        else if (!strcmp(key, "self")) o.self_count = parse_list(key, v, o.selfs, 0);
+        else if (!strcmp(key, "integrators")) o.integrator_count = parse_list(key, v, o.integrators, 1);
+        else if (!strcmp(key, "steps")) o.step_count = parse_list(key, v, o.steps, 0);
         else {
             fprintf(stderr, "unknown option %s\n", argv[i]);
             exit(2);
