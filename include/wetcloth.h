@@ -131,9 +131,9 @@ typedef struct wc_world_def {
     /// 1e-8 of the right-hand side, which also ends every solve). Default
     /// 1 (about g / 10): on the thesis drape it leaves the error against a
     /// fine-step reference solved to round-off where it was, at about 4x fewer
-    /// iterations; it is half the smallest value at which a near-
-    /// inextensible cloth gained energy (2; docs/model.md has the figures),
-    /// so larger values are faster still but may.
+    /// iterations. Larger values are faster still, but from 2 a near-
+    /// inextensible cloth gained energy (1 is half that; docs/model.md has
+    /// the figures).
     double implicit_tolerance;
 } wc_world_def;
 
