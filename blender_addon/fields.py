@@ -29,10 +29,12 @@ W: the cloth's Field Weights for the field's type times their All):
   whatever it is; Blender's terminal speed would be s / Flow).
 * Force -> force density  f = s * F * W * d, d the unit vector from the
   field to the particle (get_effector_data: from the object's origin for
-  the Point shape, from the closest point of the object's XY plane for
-  Plane, of its Z axis for Line), s read as N/m²: a positive strength pushes
-  away, a negative one pulls, as in Blender. Gravitation (1/distance²) is
-  honoured; Flow is not applied.
+  the Point shape; from the closest point of the object's XY plane for
+  Plane, so along +z or -z, away from the plane; from the closest point of
+  its Z axis for Line), s read as N/m² (Blender's cloth too applies it per
+  unit area of its faces: implicit.h, SIM_mass_spring_force_face_extern): a
+  positive strength pushes away, a negative one pulls, as in Blender.
+  Gravitation (1/distance²) is honoured; Flow is not applied.
 * Turbulence -> force density  f = s * F * W * t, t Blender's noise vector:
   t_i = 2 T(p_i) - 1 with T Blender's turbulence (BLI_noise_generic_turbulence,
   3 octaves of "new Perlin" noise, p scaled by 1/Size) at the particle's
@@ -44,7 +46,17 @@ W: the cloth's Field Weights for the field's type times their All):
 
 The falloff F (effector_falloff, falloff_func) is Blender's: Sphere, Tube
 and Cone falloff types, Power, Min/Max Distance, the Radial settings of Tube
-and Cone, and Shape's Z direction (Both, +Z, -Z); see falloff().
+and Cone, and Shape's Z direction (Both, +Z, -Z); see falloff(). The shape
+sets the distance the Sphere falloff uses (see geometry()): for a Plane
+Wind (its default) that is the height above the object's XY plane.
+
+Gravity is not a field: gravity() gives the scene's gravity times the
+Gravity weight, which is what Blender's cloth takes (SIM_mass_spring.cc,
+cloth_calc_force); All weighs the fields only.
+
+python/tests/blender/test_fields.py checks these values against closed
+forms and against Blender itself (its particle simulation evaluates the
+same fields: equal to float precision; its cloth, which objects act).
 
 Which objects are effectors (as BKE_effector_relations_create and
 BKE_effectors_create): objects with a supported field that Blender counts as
@@ -64,6 +76,8 @@ Flow, Wind Factor, Absorption, and the Surface and Every Point shapes
 (evaluated as Point); each such case is listed in `notes`.
 """
 
+from types import SimpleNamespace
+
 import numpy as np
 
 SUPPORTED = ("WIND", "FORCE", "TURBULENCE")
@@ -74,6 +88,14 @@ OUTPUT = {"WIND": AIR, "FORCE": FORCE, "TURBULENCE": FORCE}
 
 # Shapes evaluated as Blender does; others are evaluated as POINT.
 SHAPES = ("POINT", "LINE", "PLANE")
+
+# The field settings read (FieldSettings' names): copied when the sampler is
+# built, so that it holds no reference into Blender's evaluated data (which
+# the next depsgraph evaluation frees).
+SETTINGS = ("type", "strength", "shape", "falloff_type", "z_direction", "falloff_power",
+            "use_min_distance", "distance_min", "use_max_distance", "distance_max",
+            "radial_falloff", "use_radial_min", "radial_min", "use_radial_max", "radial_max",
+            "use_gravity_falloff", "size", "use_global_coords")
 
 # Blender's normalize_v3 leaves a vector whose squared length is not above
 # this as zero (BLI_math_vector_inline.c).
@@ -225,13 +247,14 @@ def turbulence_noise(points, size):
 
 
 class Effector:
-    """One field object at the current frame: its field settings, world
-    origin and unit Z axis, and the cloth's weight for it (All times the
-    type's). evaluate() gives its contribution at points."""
+    """One field object at the current frame: its field settings (a copy of
+    SETTINGS), world origin and unit Z axis, and the cloth's weight for it
+    (All times the type's). evaluate() gives its contribution at points."""
 
-    def __init__(self, ob, field, matrix, weight):
+    def __init__(self, name, field, matrix, weight):
         m = np.array(matrix, dtype=np.float64).reshape(4, 4)
-        self.name = ob.name
+        field = SimpleNamespace(**{k: getattr(field, k) for k in SETTINGS})
+        self.name = name
         self.type = field.type
         self.output = OUTPUT[field.type]
         self.field = field
@@ -398,7 +421,7 @@ class FieldSampler:
             # (for what is evaluated here) no strength: no effect
             if weight == 0.0 or not field.apply_to_location or field.strength == 0.0:
                 continue
-            self.effectors.append(Effector(ev, field, ev.matrix_world, weight))
+            self.effectors.append(Effector(ob.name, field, ev.matrix_world, weight))
             self.notes.extend(_notes(ob, field))
 
     def _ignore_particle_fields(self, ob):

@@ -12,6 +12,9 @@ effectors. Nothing here registers a class.
 
 import importlib
 import math
+import os
+import subprocess
+import sys
 from types import SimpleNamespace
 
 import bpy
@@ -20,7 +23,7 @@ import numpy as np
 import pytest
 from mathutils import noise
 
-from conftest import MODULE
+from conftest import MODULE, ROOT
 
 RNG = np.random.default_rng(7)
 POINTS = RNG.uniform(-2.0, 2.0, size=(64, 3))
@@ -117,6 +120,34 @@ def test_gravity_follows_the_scene_and_the_gravity_weight(fields, scene):
     assert np.allclose(g, [0.15, -0.3, -2.7])
     scene.use_gravity = False
     assert np.array_equal(sampler(fields).gravity(scene), np.zeros(3))
+
+
+def test_the_module_loads_on_its_own():
+    """Neither bpy nor the rest of the add-on is needed to import it."""
+    code = ("import importlib.util, sys; "
+            "s = importlib.util.spec_from_file_location('fields', sys.argv[1]); "
+            "m = importlib.util.module_from_spec(s); s.loader.exec_module(m); "
+            "assert 'bpy' not in sys.modules and 'mathutils' not in sys.modules; "
+            "print(m.SUPPORTED)")
+    path = os.path.join(ROOT, "blender_addon", "fields.py")
+    r = subprocess.run([sys.executable, "-c", code, path], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "('WIND', 'FORCE', 'TURBULENCE')"
+
+
+def test_a_sampler_keeps_the_frame_it_was_built_at(fields, scene):
+    """It copies what it reads: later changes, frames and depsgraph
+    evaluations (which free the evaluated data) do not reach it."""
+    ob = add_field("WIND", strength=1.0)
+    s = sampler(fields)
+    ob.field.strength = 5.0
+    ob.field.use_max_distance, ob.field.distance_max = True, 0.01
+    ob.rotation_euler = (1.0, 0.0, 0.0)
+    scene.frame_set(3)
+    bpy.context.evaluated_depsgraph_get()
+    air, _ = s.sample(POINTS, np.zeros_like(POINTS))
+    assert np.allclose(air, [0.0, 0.0, 1.0])
 
 
 # ---------------------------------------------------------------------------
@@ -416,7 +447,8 @@ def particle_velocities(points, kind, settings):
     scene = bpy.context.scene
     scene.frame_set(1)
     dg = bpy.context.evaluated_depsgraph_get()
-    born = np.array([p.location[:] for p in emitter.evaluated_get(dg).particle_systems[0].particles])
+    particles = emitter.evaluated_get(dg).particle_systems[0].particles
+    born = np.array([p.location[:] for p in particles])
     scene.frame_set(2)
     dg = bpy.context.evaluated_depsgraph_get()
     moved = emitter.evaluated_get(dg).particle_systems[0].particles
