@@ -324,7 +324,7 @@ def _enabled_in_layer(layer_collection, render, restricted, found):
     if not restricted:
         for ob in layer_collection.collection.objects:
             if not _hidden(ob, render):
-                found.setdefault(ob.name, ob)
+                found.setdefault(ob.as_pointer(), ob)
     for child in layer_collection.children:
         _enabled_in_layer(child, render, restricted, found)
 
@@ -337,7 +337,7 @@ def _enabled_in_collection(collection, render, restricted, found):
     if not restricted:
         for ob in collection.objects:
             if not _hidden(ob, render):
-                found.setdefault(ob.name, ob)
+                found.setdefault(ob.as_pointer(), ob)
     for child in collection.children:
         _enabled_in_collection(child, render, restricted, found)
 
@@ -404,9 +404,9 @@ class FieldSampler:
         self.ignored = []
         self.notes = []
         render = getattr(depsgraph, "mode", "VIEWPORT") == "RENDER"
-        excluded = {ob.name for ob in exclude}
+        excluded = {ob.as_pointer() for ob in exclude}  # names can repeat across libraries
         for ob in effector_candidates(view_layer, weights.collection, render):
-            if ob.name in excluded:
+            if ob.as_pointer() in excluded:
                 continue
             ev = ob.evaluated_get(depsgraph)
             self._ignore_particle_fields(ev)
