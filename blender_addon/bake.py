@@ -1,6 +1,8 @@
 """Baking: reads the Blender scene, runs libwetcloth through the `wetcloth`
-package frame by frame, writes a PC2 cache and hooks up a Mesh Cache
-modifier. No physics here: every position comes from the library. One bake
+package frame by frame, writes the point caches (positions, and wetness and
+stuck per frame) and hooks up the Wet Cloth modifiers (stack.py). No physics
+here: every position comes from the library, every field value from
+fields.py's reading of Blender's fields. One bake
 is one library world: of one object (Bake), or of every Wet Cloth object
 together (Bake All), where the library collides them with each other.
 
@@ -10,17 +12,22 @@ under the object's own (possibly animated) transform.
 """
 
 import ctypes
+import math
 import os
 import time
 
 import bpy
 import numpy as np
 
-from . import props
+from . import cache, fields, outdated, props, stack
 
-MODIFIER_NAME = "Wet Cloth Cache"
-WETNESS_ATTRIBUTE = "wet_cloth_wetness"
-STUCK_ATTRIBUTE = "wet_cloth_stuck"
+MODIFIER_NAME = stack.POSITIONS
+WETNESS_ATTRIBUTE = stack.WETNESS_ATTRIBUTE
+STUCK_ATTRIBUTE = stack.STUCK_ATTRIBUTE
+
+# The share of the stable step that automatic steps take (the library's
+# default).
+SUBSTEP_SAFETY = 0.9
 
 
 class BakeError(Exception):
@@ -147,14 +154,16 @@ def cloth_faces(mesh):
     return np.concatenate(faces).astype(np.int32)
 
 
-def group_weights(ob, name):
-    """(n,) weights of vertex group `name`, 0 outside it."""
+def group_weights(ob, mesh, name):
+    """(n,) weights of the object's vertex group `name` on `mesh` (the
+    evaluated mesh: modifiers such as Subdivision Surface carry the weights
+    over to the vertices they make), 0 outside it."""
     group = ob.vertex_groups.get(name)
     if group is None:
         raise BakeError("%s has no vertex group %r" % (ob.name, name))
     gi = group.index
-    w = np.zeros(len(ob.data.vertices))
-    for v in ob.data.vertices:
+    w = np.zeros(len(mesh.vertices))
+    for v in mesh.vertices:
         for g in v.groups:
             if g.group == gi:
                 w[v.index] = g.weight
@@ -190,32 +199,6 @@ def _evaluated_mesh(ob, depsgraph, matrix=None):
 
 
 # ---------------------------------------------------------------------------
-# Paths
-
-
-def cache_paths(ob, settings):
-    """(folder as given, absolute folder, absolute cache file)."""
-    given = settings.cache_dir.strip()
-    if not given:
-        raise BakeError("the cache folder is empty: choose one in the Wet Cloth panel")
-    if given.startswith("//") and not bpy.data.filepath:
-        raise BakeError("the cache folder %r is relative to the .blend file, which is not "
-                        "saved yet: save the file or choose an absolute folder" % given)
-    folder = os.path.normpath(bpy.path.abspath(given))
-    name = bpy.path.clean_name(ob.name) + ".pc2"
-    return given, folder, os.path.join(folder, name)
-
-
-def _check_folder(folder):
-    try:
-        os.makedirs(folder, exist_ok=True)
-    except OSError as e:
-        raise BakeError("cannot create the cache folder %s: %s" % (folder, e.strerror or e))
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise BakeError("cannot write into the cache folder %s" % folder)
-
-
-# ---------------------------------------------------------------------------
 # The bake
 
 def _world_settings(settings, scene):
@@ -227,21 +210,24 @@ def _world_settings(settings, scene):
             ("integrator", settings.integrator),
             ("solver tolerance", settings.implicit_tolerance
              if settings.integrator == "IMPLICIT" else None),
-            ("substeps", substeps))
+            ("Quality Steps", substeps),
+            ("Gravity field weight", settings.field_gravity))
 
 
 class _ClothPart:
     """One object's part of a bake: its cloth in the world, its pins, its
-    cache being written."""
+    caches being written."""
 
     def __init__(self, ob):
         self.ob = ob
         self.settings = ob.wet_cloth
-        self.writer = None
-        self.tmp_path = None
-        self.hidden_modifiers = []
+        self.writers = []
+        self.hidden = []
+        self.fields_on = {"air": False, "force": False}
 
-    def check(self, scene):
+    # before anything is made --------------------------------------------------
+
+    def check(self, scene, to_frame=None):
         """What can be checked before anything is made; BakeError if not."""
         ob, s = self.ob, self.settings
         if ob.type != "MESH":
@@ -250,21 +236,97 @@ class _ClothPart:
         if not s.enabled:
             raise BakeError("Wet Cloth is not enabled on %s: tick it in Physics > Wet Cloth"
                             % ob.name)
-        mesh = ob.data
-        if len(mesh.polygons) == 0:
-            raise BakeError("%s has no faces: a cloth needs a mesh with faces" % ob.name)
+        if ob.library is not None:
+            raise BakeError("%s is linked from another .blend file: bake it there" % ob.name)
+        try:
+            props.check_settings(s)
+        except props.SettingError as e:
+            raise BakeError("%s: %s" % (ob.name, e)) from None
         start, end = props.frame_range(s, scene)
+        if to_frame is not None:
+            end = to_frame
         if end <= start:
             raise BakeError("the frame range %d to %d is empty: the end must come after the "
                             "start" % (start, end))
-        self.given_dir, self.folder, self.path = cache_paths(ob, s)
-        n = len(mesh.vertices)
-        self.faces = cloth_faces(mesh)
-        self.wet = np.full(n, float(s.wetness))
-        if s.wetness_group:
-            self.wet *= np.clip(group_weights(ob, s.wetness_group), 0.0, 1.0)
-        self.pins = (np.flatnonzero(group_weights(ob, s.pin_group) > 0.0).astype(np.int32)
-                     if s.pin_group else np.zeros(0, np.int32))
+
+    def prepare_files(self, busy):
+        """Claims the object's cache identity and picks its files; removes
+        the temporary files of its earlier bakes that were killed."""
+        ob, s = self.ob, self.settings
+        cache.claim_identity(ob)
+        self.folder, self.folder_text = cache.folder_for(s)
+        try:
+            cache.ensure_folder(self.folder)
+        except cache.CacheError as e:
+            raise BakeError(str(e)) from None
+        own = {os.path.normpath(bpy.path.abspath(p)) for p in (s.cache_file, s.wetness_file) if p}
+        for _attempt in range(8):
+            names = cache.file_names(ob)
+            paths = [os.path.join(self.folder, n) for n in names]
+            # a file of this name that is not this object's current bake was
+            # written by someone else (a copy of this .blend baking into the
+            # same Cache Folder): a new identity, never an overwrite
+            if all(os.path.normpath(p) in own or not os.path.exists(p) for p in paths):
+                break
+            s.cache_id = props.new_cache_id()
+        else:
+            raise BakeError("cannot find free cache file names in %s" % self.folder)
+        self.path, self.wetness_path = paths
+        cache.remove_stale_temps(self.folder, s.cache_id, busy)
+
+    # the cloth ------------------------------------------------------------------
+
+    def hide_modifiers(self):
+        stack.ensure_cloth_modifier(self.ob)
+        self.hidden = stack.hide_from_cloth(self.ob)
+
+    def restore_modifiers(self):
+        stack.restore(self.ob, self.hidden)
+        self.hidden = []
+
+    def read_rest(self, depsgraph):
+        """The cloth at the first frame: the mesh as the modifiers above Wet
+        Cloth leave it. Returns its world positions."""
+        ob, s = self.ob, self.settings
+        ev = ob.evaluated_get(depsgraph)
+        mesh = ev.to_mesh()
+        try:
+            if len(mesh.polygons) == 0:
+                raise BakeError("%s has no faces: a cloth needs a mesh with faces" % ob.name)
+            self.n = len(mesh.vertices)
+            self.faces = cloth_faces(mesh)
+            local = _positions(mesh)
+            wet = np.full(self.n, float(props.checked(s, "wetness")))
+            if s.wetness_group:
+                wet *= np.clip(group_weights(ob, mesh, s.wetness_group), 0.0, 1.0)
+            self.wet = wet
+            pins = group_weights(ob, mesh, s.pin_group) if s.pin_group else np.zeros(self.n)
+        finally:
+            ev.to_mesh_clear()
+        self.hard_pins = np.flatnonzero(pins >= props.HARD_PIN_WEIGHT).astype(np.int32)
+        soft = (pins > 0.0) & (pins < props.HARD_PIN_WEIGHT)
+        self.soft_pins = np.flatnonzero(soft).astype(np.int32)
+        self.soft_stiffness = float(props.checked(s, "pin_stiffness")) * pins[soft]
+        self.pins = np.concatenate([self.hard_pins, self.soft_pins])
+        self.matrix = _matrix(ev.matrix_world)
+        return _to_world(local, self.matrix)
+
+    def world_positions(self, depsgraph, frame):
+        """The evaluated mesh in world space at this frame (its pins'
+        motion); sets matrix."""
+        ev = self.ob.evaluated_get(depsgraph)
+        mesh = ev.to_mesh()
+        try:
+            if len(mesh.vertices) != self.n:
+                raise BakeError(
+                    "the modifiers above Wet Cloth on %s change its vertex count at frame %d "
+                    "(%d, was %d): a cloth keeps its vertices" % (self.ob.name, frame,
+                                                                  len(mesh.vertices), self.n))
+            v = _positions(mesh)
+        finally:
+            ev.to_mesh_clear()
+        self.matrix = _matrix(ev.matrix_world)
+        return _to_world(v, self.matrix)
 
     def find_colliders(self, scene, view_layer, cloth_objects):
         """The objects this cloth collides with (none when Object Collisions
@@ -287,136 +349,104 @@ class _ClothPart:
         self.cloth = world.add_cloth(start_world, self.faces, material=material,
                                      wetness=self.wet, self_collision=s.self_collision,
                                      collide_with_cloths=collide_with_cloths)
-        if self.pins.size:
-            self.cloth.pin(self.pins)
+        if self.hard_pins.size:
+            self.cloth.pin(self.hard_pins)
+        if self.soft_pins.size:
+            self.cloth.pin(self.soft_pins, stiffness=self.soft_stiffness)
 
-    def open_cache(self, wetcloth, frame_count, start_frame):
-        self.tmp_path = os.path.join(self.folder, ".%s.%d.tmp" % (os.path.basename(self.path),
-                                                                  os.getpid()))
-        try:
-            self.writer = wetcloth.meshio.PC2Writer(self.tmp_path, len(self.ob.data.vertices),
-                                                    frame_count, start=float(start_frame))
-        except OSError as e:
-            raise BakeError("cannot write the cache %s: %s" % (self.tmp_path, e.strerror or e))
-
-    def hide_cache_modifiers(self):
-        mods = list(self.ob.modifiers)
-        for i, m in enumerate(mods):
-            if m.type == "MESH_CACHE" and m.name == MODIFIER_NAME:
-                for later in mods[i:]:
-                    if later.show_viewport:
-                        later.show_viewport = False
-                        self.hidden_modifiers.append(later.name)
-                break
-
-    def restore_modifiers(self):
-        for name in self.hidden_modifiers:
-            m = self.ob.modifiers.get(name)
-            if m is not None:
-                m.show_viewport = True
-        self.hidden_modifiers = []
-
-    def world_positions(self, depsgraph):
-        """The evaluated mesh in world space (its pins' motion); sets matrix."""
-        ev = self.ob.evaluated_get(depsgraph)
-        n = len(self.ob.data.vertices)
-        mesh = ev.to_mesh()
-        try:
-            if len(mesh.vertices) != n:
-                raise BakeError(
-                    "the modifiers of %s change its vertex count (%d, the mesh has %d): move "
-                    "them below the %r modifier or apply them" % (self.ob.name,
-                                                                  len(mesh.vertices), n,
-                                                                  MODIFIER_NAME))
-            v = _positions(mesh)
-        finally:
-            ev.to_mesh_clear()
-        self.matrix = _matrix(ev.matrix_world)
-        return _to_world(v, self.matrix)
-
-    def follow(self, depsgraph):
+    def follow(self, depsgraph, frame):
         """The pins' targets (or the object's transform) at the new frame."""
         if self.pins.size:
-            self.cloth.set_pin_targets(self.world_positions(depsgraph)[self.pins])
+            self.cloth.set_pin_targets(self.world_positions(depsgraph, frame)[self.pins])
         else:
             self.matrix = _matrix(self.ob.evaluated_get(depsgraph).matrix_world)
 
-    def write_frame(self, world_positions, matrix=None):
-        self.writer.write(_to_local(world_positions,
-                                    self.matrix if matrix is None else _matrix(matrix)))
+    def apply_fields(self, sampler, gravity_only=False):
+        """The force fields at the cloth's particles, for the next frame."""
+        air, force = sampler.sample(self.cloth.positions, self.cloth.velocities)
+        for key, value, setter in (("air", air, "set_air_velocity"),
+                                   ("force", force, "set_external_forces")):
+            if value is not None or self.fields_on[key]:
+                getattr(self.cloth, setter)(value)
+                self.fields_on[key] = value is not None
 
-    def take_cache(self):
-        """Closes the new cache and puts it in place of the previous one."""
-        s = self.settings
-        self.writer.close()
-        self.writer = None
-        previous = bpy.path.abspath(s.cache_file) if s.cache_file else ""
-        os.replace(self.tmp_path, self.path)
-        self.tmp_path = None
-        if previous and os.path.normpath(previous) != self.path and os.path.isfile(previous):
+    # the caches -------------------------------------------------------------------
+
+    def open_caches(self, wetcloth, frame_count, start_frame):
+        self.tmp_paths = [cache.temp_path(self.path), cache.temp_path(self.wetness_path)]
+        for tmp in self.tmp_paths:
             try:
-                os.remove(previous)
-            except OSError:
-                pass
+                self.writers.append(wetcloth.meshio.PC2Writer(tmp, self.n, frame_count,
+                                                              start=float(start_frame)))
+            except OSError as e:
+                raise BakeError("cannot write the cache %s: %s" % (tmp, e.strerror or e))
 
-    def hook_up(self, start_frame, frame_count, wetness, stuck, info):
-        """The Mesh Cache modifier, the attributes and the settings."""
+    def write_frame(self, world_positions, matrix=None):
+        local = _to_local(world_positions, self.matrix if matrix is None else _matrix(matrix))
+        state = np.zeros((self.n, 3))
+        state[:, 0] = self.cloth.wetness
+        state[:, 1] = self.cloth.stuck
+        self.writers[0].write(local)
+        self.writers[1].write(state)
+
+    def take_caches(self):
+        """Closes the new caches and puts them in place of the previous
+        ones; the previous ones go if they are this object's own."""
+        s = self.settings
+        for w in self.writers:
+            w.close()
+        self.writers = []
+        previous = stack.referenced_files(self.ob) | {
+            bpy.path.abspath(p) for p in (s.cache_file, s.wetness_file) if p}
+        for tmp, final in zip(self.tmp_paths, (self.path, self.wetness_path)):
+            os.replace(tmp, final)
+        self.tmp_paths = []
+        new = {os.path.normpath(self.path), os.path.normpath(self.wetness_path)}
+        self.replaced = [p for p in previous if os.path.normpath(p) not in new]
+
+    def hook_up(self, start_frame, frame_count, info, inputs):
+        """The modifiers and the settings; then the replaced files go."""
         ob, s = self.ob, self.settings
-        file_setting = self.path
-        if self.given_dir.startswith("//"):
-            file_setting = bpy.path.relpath(self.path)
-        mod = ob.modifiers.get(MODIFIER_NAME)
-        if mod is None or mod.type != "MESH_CACHE":
-            mod = ob.modifiers.new(MODIFIER_NAME, "MESH_CACHE")
-        mod.cache_format = "PC2"
-        mod.filepath = file_setting
-        mod.frame_start = float(start_frame)
-        mod.frame_scale = 1.0
-        mod.play_mode = "SCENE"
-        mod.time_mode = "FRAME"
-        mod.deform_mode = "OVERWRITE"
-        mod.interpolation = "LINEAR"
-        mod.forward_axis = "POS_Y"
-        mod.up_axis = "POS_Z"
-        mod.factor = 1.0
-        mod.show_viewport = True
-        mod.show_render = True
-
-        set_attribute(ob.data, WETNESS_ATTRIBUTE, wetness)
-        set_attribute(ob.data, STUCK_ATTRIBUTE, stuck)
-
-        s.cache_file = file_setting
+        stack.hook_up(ob, cache.file_setting(self.path), cache.file_setting(self.wetness_path),
+                      start_frame)
+        s.cache_file = self.path
+        s.wetness_file = self.wetness_path
         s.baked_frames = frame_count
         s.baked_start = start_frame
         s.bake_info = info
+        s.baked_inputs = "\n".join(sorted(inputs))
+        s.outdated = False
+        cache.delete_own(self.replaced, ob)
         ob.update_tag()
 
-    def drop_cache(self):
+    def drop_caches(self):
         """Removes what this bake wrote for the object."""
-        if self.writer is not None:
+        for w in self.writers:
             try:
-                self.writer.file.close()
+                w.file.close()
             except OSError:
                 pass
-            self.writer = None
-        if self.tmp_path and os.path.exists(self.tmp_path):
-            try:
-                os.remove(self.tmp_path)
-            except OSError:
-                pass
-        self.tmp_path = None
+        self.writers = []
+        for tmp in getattr(self, "tmp_paths", []):
+            if os.path.exists(tmp):
+                try:
+                    os.remove(tmp)
+                except OSError:
+                    pass
+        self.tmp_paths = []
         self.restore_modifiers()
 
 
 class Baker:
     """One bake of one or more objects in one world, where they collide with
-    each other (those with Collide with Cloths) and share the colliders:
+    each other (those with Cloth Collisions) and share the colliders:
     start(), step() until done, then finish(); abort() at any point leaves
     every object's previous bake as it was. The world's settings (frame
-    range, integrator, substeps) come from the first object, and the others
-    must agree with it."""
+    range, integrator, steps) come from the first object, and the others
+    must agree with it. `to_frame` ends the bake at that frame instead of
+    the range's end (Bake to Current Frame)."""
 
-    def __init__(self, context, objects):
+    def __init__(self, context, objects, to_frame=None, log=None):
         self.scene = context.scene
         self.view_layer = context.view_layer
         if not isinstance(objects, (list, tuple)):
@@ -424,15 +454,23 @@ class Baker:
         self.parts = [_ClothPart(ob) for ob in objects]
         self.ob = objects[0]
         self.settings = self.ob.wet_cloth
+        self.to_frame = to_frame
+        self.log = log
         self.world = None
         self.frame_before = self.scene.frame_current
         self.done = False
         self.info = ""
+        self.warnings = []
         self.started = time.perf_counter()
+        self._logged = -1
 
     @property
     def objects(self):
         return [p.ob for p in self.parts]
+
+    @property
+    def temp_files(self):
+        return [t for p in self.parts for t in getattr(p, "tmp_paths", [])]
 
     # setup ------------------------------------------------------------------
 
@@ -445,15 +483,6 @@ class Baker:
                                     "same %s: %s has %s, %s has %s" % (
                                         name, self.ob.name, want, p.ob.name, got))
 
-    def _check_paths(self):
-        seen = {}
-        for p in self.parts:
-            other = seen.get(p.path)
-            if other is not None:
-                raise BakeError("%s and %s would write the same cache %s: rename one or give "
-                                "it another cache folder" % (other, p.ob.name, p.path))
-            seen[p.path] = p.ob.name
-
     def _shared_colliders(self, cloth_objects):
         """Every collider of any of the cloths, once, in the order found."""
         found = []
@@ -463,39 +492,89 @@ class Baker:
                     found.append(o)
         return found
 
-    def start(self):
+    def _samplers(self, depsgraph):
+        return [fields.FieldSampler(self.scene, self.view_layer, depsgraph,
+                                    props.FieldWeights(p.settings), exclude=self.objects)
+                for p in self.parts]
+
+    def _check_work(self):
+        """Refuses a bake above the Work Limit before it starts, with the
+        estimate and what would make it cheaper."""
+        if self.settings.substeps_auto:
+            stable = self.world.stable_dt()
+            steps = 1 if not math.isfinite(stable) else max(1, math.ceil(
+                self.frame_dt / (SUBSTEP_SAFETY * stable)))
+        else:
+            steps = int(self.settings.substeps)
+        self.steps_estimate = steps
+        vertices = sum(p.n for p in self.parts)
+        work = vertices * steps * (self.frame_count - 1)
+        limit = float(self.settings.work_limit) * 1e6
+        if work > limit:
+            advice = []
+            if self.settings.integrator == "VERLET":
+                advice.append("choose the Semi-Implicit or Strain Limited integrator, which need "
+                              "far fewer steps")
+            if not self.settings.substeps_auto:
+                advice.append("lower the Quality Steps")
+            elif self.settings.integrator == "VERLET":
+                advice.append("a softer or coarser cloth")
+            advice.append("or raise the Work Limit in the Cache panel")
+            raise BakeError(
+                "this bake would be about %.3g million vertex steps (%d vertices x %d steps per "
+                "frame x %d frames), more than the Work Limit of %g million: %s" % (
+                    work / 1e6, vertices, steps, self.frame_count - 1,
+                    self.settings.work_limit, "; ".join(advice)))
+
+    def start(self, busy=()):
         scene = self.scene
         for p in self.parts:
-            p.check(scene)
+            p.check(scene, self.to_frame)
         self._check_world_settings()
-        self._check_paths()
         self.start_frame, self.end_frame = props.frame_range(self.settings, scene)
+        if self.to_frame is not None:
+            self.end_frame = self.to_frame
         self.frame_count = self.end_frame - self.start_frame + 1
         self.frame = self.start_frame
         self.frame_dt = scene.render.fps_base / scene.render.fps
-        self.colliders = self._shared_colliders(self.objects)
         for p in self.parts:
-            _check_folder(p.folder)
+            p.prepare_files(busy)
+        seen = {}
+        for p in self.parts:
+            other = seen.get(p.path)
+            if other is not None:
+                raise BakeError("%s and %s would write the same cache %s" % (other, p.ob.name,
+                                                                              p.path))
+            seen[p.path] = p.ob.name
 
         wetcloth = load_wetcloth()
         self.wetcloth = wetcloth
 
-        # The cloth's own motion (pins) is read from the mesh as evaluated
-        # without this add-on's cache and what comes after it.
+        # The cloth's rest shape and its own motion (pins) are read from the
+        # mesh as the modifiers above Wet Cloth make it.
         for p in self.parts:
-            p.hide_cache_modifiers()
+            p.hide_modifiers()
         scene.frame_set(self.start_frame)
         depsgraph = self._depsgraph()
-        start_world = [p.world_positions(depsgraph) for p in self.parts]
+        start_world = [p.read_rest(depsgraph) for p in self.parts]
+        self.colliders = self._shared_colliders(self.objects)
+        samplers = self._samplers(depsgraph)
+        for s in samplers:
+            self.warnings.extend("field %s (%s) is not supported and was ignored" % (name, kind)
+                                 for name, kind in s.ignored)
+            self.warnings.extend("field %s (%s): %s" % note for note in s.notes)
+        self.inputs = {o.name for o in self.colliders}
+        self.inputs.update(e.name for s in samplers for e in s.effectors)
 
-        gravity = tuple(scene.gravity) if scene.use_gravity else (0.0, 0.0, 0.0)
         # alone, a cloth is baked as it always was (collide_with_cloths
         # then changes nothing: a world of one cloth has no group)
         together = len(self.parts) > 1
         try:
-            self.world = wetcloth.World(gravity=gravity,
+            self.world = wetcloth.World(gravity=tuple(samplers[0].gravity(scene)),
                                         integrator=props.integrator_name(self.settings),
-                                        implicit_tolerance=self.settings.implicit_tolerance)
+                                        implicit_tolerance=float(self.settings.implicit_tolerance),
+                                        substep_safety=SUBSTEP_SAFETY,
+                                        max_substeps=props.OTHER_RANGES["substeps"][1])
             for p, positions in zip(self.parts, start_world):
                 p.add_to(self.world, wetcloth, positions,
                          not together or p.settings.collide_with_cloths)
@@ -510,11 +589,13 @@ class Baker:
                     friction=min(10.0, float(c.cloth_friction) / 10.0)))
         except wetcloth.WetclothError as e:
             raise BakeError(str(e)) from None
+        self._check_work()
 
         for p, positions in zip(self.parts, start_world):
-            p.open_cache(wetcloth, self.frame_count, self.start_frame)
+            p.open_caches(wetcloth, self.frame_count, self.start_frame)
             p.write_frame(positions, p.ob.matrix_world)
         self.substeps = 0
+        self._log_progress()
 
     def _depsgraph(self):
         return bpy.context.evaluated_depsgraph_get()
@@ -536,8 +617,9 @@ class Baker:
                                     "%d): colliders must keep their topology" %
                                     (o.name, self.frame, v.shape[0], c.vertices.shape[0]))
                 c.set_vertices(v)
-            for p in self.parts:
-                p.follow(depsgraph)
+            for p, sampler in zip(self.parts, self._samplers(depsgraph)):
+                p.follow(depsgraph, self.frame)
+                p.apply_fields(sampler)
             substeps = 0 if self.settings.substeps_auto else self.settings.substeps
             self.substeps += self.world.advance(self.frame_dt, substeps)
             positions = [p.cloth.positions for p in self.parts]
@@ -547,81 +629,102 @@ class Baker:
             p.write_frame(x)
         if self.frame >= self.end_frame:
             self.done = True
+        self._log_progress()
 
     @property
     def progress(self):
         return self.frame - self.start_frame + 1
 
+    def status_text(self):
+        elapsed = time.perf_counter() - self.started
+        done = self.progress - 1
+        left = ""
+        if done > 0 and not self.done:
+            left = ", about %s left" % _duration(elapsed / done * (self.frame_count - 1 - done))
+        return "Wet Cloth: baking %s, frame %d of %d (%d %%)%s" % (
+            ", ".join(o.name for o in self.objects), self.frame, self.end_frame,
+            100 * done // max(1, self.frame_count - 1), left)
+
+    def _log_progress(self):
+        """One line on the log every 5 % (headless bakes)."""
+        if self.log is None:
+            return
+        percent = 100 * (self.progress - 1) // max(1, self.frame_count - 1)
+        if percent // 5 > self._logged or self.done:
+            self._logged = percent // 5
+            self.log(self.status_text())
+
     # ending -----------------------------------------------------------------
 
     def finish(self):
-        """Puts the new caches in place, then the modifiers and attributes."""
+        """Puts the new caches in place, then the modifiers."""
         for p in self.parts:
-            p.take_cache()
-        state = [(p.cloth.wetness, p.cloth.stuck.astype(np.float64)) for p in self.parts]
+            p.take_caches()
         elapsed = time.perf_counter() - self.started
         frames = self.frame_count - 1
         self.world.close()
-        self.info = "%d frames in %.1f s, %.1f substeps per frame" % (
+        self.info = "%d frames in %.1f s, %.1f steps per frame" % (
             self.frame_count, elapsed, self.substeps / max(1, frames))
-        for p, (wetness, stuck) in zip(self.parts, state):
-            p.restore_modifiers()
-            others = [o.name for o in self.objects if o is not p.ob]
-            p.hook_up(self.start_frame, self.frame_count, wetness, stuck,
-                      self.info + (", with " + ", ".join(others) if others else ""))
-        self.scene.frame_set(self.frame_before)
+        with outdated.suppressed():
+            for p in self.parts:
+                p.restore_modifiers()
+                others = [o.name for o in self.objects if o is not p.ob]
+                p.hook_up(self.start_frame, self.frame_count,
+                          self.info + (", with " + ", ".join(others) if others else ""),
+                          self.inputs)
+            self.scene.frame_set(self.frame_before)
+            bpy.context.view_layer.update()
 
     def abort(self):
         """Drops what this bake wrote; the previous bakes stay."""
-        for p in self.parts:
-            p.drop_cache()
-        if self.world is not None:
-            self.world.close()
-        self.scene.frame_set(self.frame_before)
+        with outdated.suppressed():
+            for p in self.parts:
+                p.drop_caches()
+            if self.world is not None:
+                self.world.close()
+            self.scene.frame_set(self.frame_before)
+            bpy.context.view_layer.update()
+
+
+def _duration(seconds):
+    if seconds < 90:
+        return "%.0f s" % seconds
+    if seconds < 5400:
+        return "%.0f min" % (seconds / 60)
+    return "%.1f h" % (seconds / 3600)
 
 
 def bake_all_objects(context):
     """The objects Bake All bakes: every mesh in the view layer with Wet
     Cloth enabled, by name."""
     return sorted((o for o in context.view_layer.objects
-                   if o.type == "MESH" and o.wet_cloth.enabled), key=lambda o: o.name)
+                   if o.type == "MESH" and o.wet_cloth.enabled and o.library is None),
+                  key=lambda o: o.name)
 
 
-def set_attribute(mesh, name, values):
-    a = mesh.attributes.get(name)
-    if a is not None and (a.data_type != "FLOAT" or a.domain != "POINT"):
-        mesh.attributes.remove(a)
-        a = None
-    if a is None:
-        a = mesh.attributes.new(name, "FLOAT", "POINT")
-    a.data.foreach_set("value", np.asarray(values, dtype=np.float32))
+def is_baked(ob):
+    return bool(ob.wet_cloth.cache_file) or bool(stack.referenced_files(ob))
 
 
 def free_bake(ob):
-    """Removes the modifier, the cache file and the attributes. Returns what
-    was removed, as words."""
+    """Removes the bake's modifiers and those of its files that are this
+    object's own (cache.delete_own). Returns (what was removed, as words;
+    files kept, as [(path, why)])."""
     s = ob.wet_cloth
+    files = stack.referenced_files(ob) | {
+        bpy.path.abspath(p) for p in (s.cache_file, s.wetness_file) if p}
     removed = []
-    mod = ob.modifiers.get(MODIFIER_NAME)
-    if mod is not None and mod.type == "MESH_CACHE":
-        ob.modifiers.remove(mod)
-        removed.append("modifier")
-    if s.cache_file:
-        path = bpy.path.abspath(s.cache_file)
-        if os.path.isfile(path):
-            try:
-                os.remove(path)
-                removed.append("cache")
-            except OSError as e:
-                raise BakeError("cannot remove the cache %s: %s" % (path, e.strerror or e))
-    if ob.type == "MESH":
-        for name in (WETNESS_ATTRIBUTE, STUCK_ATTRIBUTE):
-            a = ob.data.attributes.get(name)
-            if a is not None:
-                ob.data.attributes.remove(a)
-                if "attributes" not in removed:
-                    removed.append("attributes")
-    s.cache_file = ""
-    s.baked_frames = 0
-    s.bake_info = ""
-    return removed
+    with outdated.suppressed():
+        if stack.remove_bake(ob, keep_cloth_modifier=s.enabled):
+            removed.append("modifiers")
+        deleted, kept = cache.delete_own(sorted(files), ob)
+        if deleted:
+            removed.append("cache files")
+        s.cache_file = ""
+        s.wetness_file = ""
+        s.baked_frames = 0
+        s.bake_info = ""
+        s.baked_inputs = ""
+        s.outdated = False
+        bpy.context.view_layer.update()
+    return removed, kept

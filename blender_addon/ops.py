@@ -1,16 +1,28 @@
-"""Operators: wetcloth.bake (the active object), wetcloth.bake_all (every Wet Cloth
-object together, in one world), wetcloth.free_bake and wetcloth.free_bake_all."""
+"""Operators: wetcloth.bake (the active object; to_current_frame for Bake to
+Current Frame), wetcloth.bake_all (every Wet Cloth object together, in one
+world), wetcloth.free_bake, wetcloth.free_bake_all and
+wetcloth.add_wet_material."""
 
 import time
 import traceback
 
 import bpy
-from bpy.props import StringProperty
+from bpy.props import BoolProperty, StringProperty
 
-from . import bake
+from . import bake, material
 
-# Objects being baked interactively right now (one bake at a time per object).
+# Objects being baked interactively right now (one bake at a time per object),
+# and their bakes (whose temporary files are not stale).
 _running = set()
+_bakers = []
+
+
+def _busy_files():
+    return {t for b in _bakers for t in b.temp_files}
+
+
+def _log(line):
+    print(line, flush=True)
 
 
 def _target(op, context):
@@ -59,7 +71,10 @@ class _BakeOperator:
         if busy:
             self.report({"ERROR"}, "%s is being baked already" % ", ".join(busy))
             return None
-        return bake.Baker(context, objects)
+        to_frame = context.scene.frame_current if getattr(self, "to_current_frame", False) \
+            else None
+        return bake.Baker(context, objects, to_frame=to_frame,
+                          log=_log if bpy.app.background else None)
 
     def _failed(self, baker, e):
         baker.abort()
@@ -68,6 +83,8 @@ class _BakeOperator:
         return {"CANCELLED"}
 
     def _baked(self, baker):
+        for w in baker.warnings:
+            self.report({"WARNING"}, "Wet Cloth: " + w)
         self.report({"INFO"}, "Wet Cloth: baked %s, %s" % (_names(baker.objects), baker.info))
         return {"FINISHED"}
 
@@ -80,7 +97,7 @@ class _BakeOperator:
         wm = context.window_manager
         progress = False
         try:
-            baker.start()
+            baker.start(_busy_files())
             wm.progress_begin(0, baker.frame_count)
             progress = True
             while not baker.done:
@@ -116,19 +133,18 @@ class _BakeOperator:
         if baker is None:
             return {"CANCELLED"}
         try:
-            baker.start()
+            baker.start(_busy_files())
         except Exception as e:
             return self._failed(baker, e)
         self._baker = baker
+        _bakers.append(baker)
         _running.update(o.name for o in baker.objects)
         context.window_manager.progress_begin(0, baker.frame_count)
         self._status(context)
         return {"RUNNING_MODAL"}
 
     def _status(self, context):
-        b = self._baker
-        text = "Wet Cloth: baking %s, frame %d of %d (Esc to cancel)" % (
-            _names(b.objects), b.progress, b.frame_count)
+        text = self._baker.status_text() + " (Esc to cancel)"
         if context.workspace is not None and context.window is not None:
             context.workspace.status_text_set(text)
 
@@ -141,6 +157,8 @@ class _BakeOperator:
         if context.workspace is not None and context.window is not None:
             context.workspace.status_text_set(None)
         _running.difference_update(o.name for o in self._baker.objects)
+        if self._baker in _bakers:
+            _bakers.remove(self._baker)
 
     def modal(self, context, event):
         b = self._baker
@@ -169,14 +187,16 @@ class _BakeOperator:
 
 
 class WETCLOTH_OT_bake(_BakeOperator, bpy.types.Operator):
-    """Bake the wet cloth simulation of the object into a PC2 cache played back by a Mesh Cache
-modifier (Esc cancels and keeps the previous bake)"""
+    """Bake the wet cloth simulation of the object (Esc cancels and keeps the previous bake)"""
     bl_idname = "wetcloth.bake"
     bl_label = "Bake Wet Cloth"
     bl_options = {"REGISTER"}
 
     object: StringProperty(name="Object", default="", options={"SKIP_SAVE"},
                            description="Object to bake (default: the active object)")
+    to_current_frame: BoolProperty(
+        name="To Current Frame", default=False, options={"SKIP_SAVE"},
+        description="Bake from the start frame to the scene's current frame only")
 
     def _objects(self, context):
         return [_target(self, context)]
@@ -203,7 +223,8 @@ the previous bakes)"""
 
 
 class WETCLOTH_OT_free_bake(bpy.types.Operator):
-    """Remove the baked cache, its Mesh Cache modifier and the wetness attributes"""
+    """Remove the bake: its modifiers, and its cache files (files another object or .blend file
+plays are kept)"""
     bl_idname = "wetcloth.free_bake"
     bl_label = "Free Wet Cloth Bake"
     bl_options = {"REGISTER", "UNDO"}
@@ -216,10 +237,11 @@ class WETCLOTH_OT_free_bake(bpy.types.Operator):
             ob = _target(self, context)
             if ob.name in _running:
                 raise bake.BakeError("%s is being baked: cancel the bake first" % ob.name)
-            removed = bake.free_bake(ob)
+            removed, kept = bake.free_bake(ob)
         except bake.BakeError as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
+        _report_kept(self, kept)
         if removed:
             self.report({"INFO"}, "Wet Cloth: freed the bake of %s (%s)" % (
                 ob.name, ", ".join(removed)))
@@ -229,8 +251,8 @@ class WETCLOTH_OT_free_bake(bpy.types.Operator):
 
 
 class WETCLOTH_OT_free_bake_all(bpy.types.Operator):
-    """Remove the baked caches, Mesh Cache modifiers and wetness attributes of every Wet Cloth
-object of the view layer"""
+    """Remove the bakes of every Wet Cloth object of the view layer (files another object or
+.blend file plays are kept)"""
     bl_idname = "wetcloth.free_bake_all"
     bl_label = "Free All Wet Cloth Bakes"
     bl_options = {"REGISTER", "UNDO"}
@@ -244,7 +266,9 @@ object of the view layer"""
         freed = []
         try:
             for ob in objects:
-                if bake.free_bake(ob):
+                removed, kept = bake.free_bake(ob)
+                _report_kept(self, kept)
+                if removed:
                     freed.append(ob.name)
         except bake.BakeError as e:
             self.report({"ERROR"}, str(e))
@@ -254,8 +278,38 @@ object of the view layer"""
         return {"FINISHED"}
 
 
+def _report_kept(op, kept):
+    for path, why in kept:
+        op.report({"INFO"}, "Wet Cloth: kept %s: %s" % (path, why))
+
+
+class WETCLOTH_OT_add_wet_material(bpy.types.Operator):
+    """Make the active material darken and shine where the baked cloth is wet (a new material
+if the object has none)"""
+    bl_idname = "wetcloth.add_wet_material"
+    bl_label = "Add Wet Material"
+    bl_options = {"REGISTER", "UNDO"}
+
+    object: StringProperty(name="Object", default="", options={"SKIP_SAVE"},
+                           description="Object whose material to set up (default: the active "
+                                       "object)")
+
+    def execute(self, context):
+        try:
+            ob = _target(self, context)
+            if ob.type != "MESH":
+                raise bake.BakeError("%s is not a mesh" % ob.name)
+            mat, added = material.add_wet_shading(ob)
+        except (bake.BakeError, ValueError) as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        self.report({"INFO"}, "Wet Cloth: %s %s" % (
+            mat.name, "now shows the baked wetness" if added else "already shows the wetness"))
+        return {"FINISHED"}
+
+
 classes = (WETCLOTH_OT_bake, WETCLOTH_OT_bake_all, WETCLOTH_OT_free_bake,
-           WETCLOTH_OT_free_bake_all)
+           WETCLOTH_OT_free_bake_all, WETCLOTH_OT_add_wet_material)
 
 
 def register():

@@ -166,6 +166,12 @@ def main(argv=None):
         for name in sorted(os.listdir(ADDON_SRC)):
             if name.endswith(".py"):
                 entries.append((name, os.path.join(ADDON_SRC, name)))
+        presets = os.path.join(ADDON_SRC, "presets")
+        for folder, _dirs, files in sorted(os.walk(presets)):
+            for name in sorted(files):
+                if name.endswith(".py"):
+                    path = os.path.join(folder, name)
+                    entries.append((os.path.relpath(path, ADDON_SRC).replace(os.sep, "/"), path))
         for name in sorted(os.listdir(PACKAGE_SRC)):
             if name.endswith((".py", ".json")):
                 entries.append(("wetcloth/" + name, os.path.join(PACKAGE_SRC, name)))

@@ -75,6 +75,15 @@ def empty_scene(installed):
 
 
 @pytest.fixture
-def cache_dir():
-    path = tempfile.mkdtemp(prefix="cache-", dir=WORK)
-    return path + os.sep
+def project(empty_scene):
+    """A fresh folder with the empty scene saved in it as shot.blend: its
+    bakes go to <folder>/wetcloth_shot/."""
+    path = tempfile.mkdtemp(prefix="project-", dir=WORK)
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.join(path, "shot.blend"))
+    return path
+
+
+@pytest.fixture
+def cache_dir(project):
+    """The folder the bakes of the saved scene go to."""
+    return os.path.join(project, "wetcloth_shot") + os.sep

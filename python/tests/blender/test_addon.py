@@ -57,8 +57,10 @@ def add_sphere(location=(0.0, 0.0, 0.0), collision=True):
     return ob
 
 
-def add_cloth(cache_dir, z=0.6, cuts=15, name="Cloth"):
-    """A 1 m plane of (cuts+2)^2 vertices at height z, Wet Cloth enabled."""
+def add_cloth(_cache_dir=None, z=0.6, cuts=15, name="Cloth"):
+    """A 1 m plane of (cuts+2)^2 vertices at height z, Wet Cloth enabled
+    (its bakes go where the file's are: the cache_dir fixture's folder when
+    the project fixture saved it)."""
     bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.0, 0.0, z))
     ob = bpy.context.object
     ob.name = name
@@ -66,7 +68,6 @@ def add_cloth(cache_dir, z=0.6, cuts=15, name="Cloth"):
     bpy.ops.mesh.subdivide(number_cuts=cuts)
     bpy.ops.object.mode_set(mode="OBJECT")
     ob.wet_cloth.enabled = True
-    ob.wet_cloth.cache_dir = cache_dir
     return ob
 
 
@@ -85,6 +86,30 @@ def bake_error(ob, **kw):
 
 def cache_path(ob):
     return bpy.path.abspath(ob.wet_cloth.cache_file)
+
+
+def wetness_path(ob):
+    return bpy.path.abspath(ob.wet_cloth.wetness_file)
+
+
+def cache_names(ob):
+    """The names of the object's two cache files."""
+    return sorted([os.path.basename(cache_path(ob)), os.path.basename(wetness_path(ob))])
+
+
+def evaluated_attribute(ob, name):
+    """A point attribute of the evaluated object at the current frame."""
+    dg = bpy.context.evaluated_depsgraph_get()
+    ev = ob.evaluated_get(dg)
+    m = ev.to_mesh()
+    try:
+        a = m.attributes.get(name)
+        assert a is not None, (name, m.attributes.keys())
+        out = np.empty(len(m.vertices), np.float32)
+        a.data.foreach_get("value", out)
+        return out
+    finally:
+        ev.to_mesh_clear()
 
 
 def world_matrix(ob):
@@ -115,7 +140,9 @@ def test_zip_contents(addon_zip):
         names = set(z.namelist())
         manifest = z.read("blender_manifest.toml").decode()
     assert os.path.basename(addon_zip) == "wetcloth-0.1.0-linux_x64.zip"
-    for name in ("__init__.py", "bake.py", "ops.py", "props.py", "ui.py",
+    for name in ("__init__.py", "bake.py", "ops.py", "props.py", "ui.py", "cache.py",
+                 "stack.py", "fields.py", "outdated.py", "material.py", "presets.py",
+                 "presets/wet_cloth/Cotton.py", "presets/wet_cloth/Towel.py",
                  "wetcloth/__init__.py", "wetcloth/_core.py", "wetcloth/_ffi.py",
                  "wetcloth/meshio.py", "wetcloth/libwetcloth.so"):
         assert name in names, name
@@ -144,17 +171,41 @@ def test_installed_through_extensions(installed):
     assert hasattr(bpy.ops.wetcloth, "bake") and hasattr(bpy.ops.wetcloth, "free_bake")
 
 
-def test_presets(empty_scene, cache_dir):
-    s = add_cloth(cache_dir).wet_cloth
-    assert s.preset == "COTTON" and s.density == pytest.approx(0.15)
-    s.preset = "DENIM"
+def _preset(ob, path):
+    with bpy.context.temp_override(active_object=ob, object=ob):
+        assert bpy.ops.script.execute_preset(filepath=path,
+                                             menu_idname="WETCLOTH_PT_presets") == {"FINISHED"}
+
+
+def test_presets(empty_scene, installed):
+    """Blender's preset system: the bundled presets set the material, the
+    menu's label follows the last one, and a user preset is written to the
+    user's presets folder and loads back."""
+    s = add_cloth().wet_cloth
+    assert s.density == pytest.approx(0.15)  # the library's cotton
+    ob = bpy.context.object
+    folder = installed.presets.BUNDLED
+    assert sorted(os.listdir(folder)) == ["Cotton.py", "Denim.py", "Silk.py", "Towel.py"]
+    _preset(ob, os.path.join(folder, "Denim.py"))
     assert s.density == pytest.approx(0.40) and s.stretch == pytest.approx(3000.0)
-    s.preset = "SILK"
-    assert s.density == pytest.approx(0.06)
-    s.adhesion = 55.0  # a hand edit makes the material custom, keeping the values
-    assert s.preset == "CUSTOM" and s.density == pytest.approx(0.06)
-    s.preset = "TOWEL"
-    assert s.density == pytest.approx(0.45) and s.preset == "TOWEL"
+    assert bpy.types.WETCLOTH_PT_presets.bl_label == "Denim"
+    _preset(ob, os.path.join(folder, "Silk.py"))
+    assert s.density == pytest.approx(0.06) and s.thickness == pytest.approx(0.002)
+    s.adhesion = 55.0
+    with bpy.context.temp_override(active_object=ob, object=ob):
+        assert bpy.ops.wetcloth.preset_add(name="Sticky Silk") == {"FINISHED"}
+    user = bpy.utils.user_resource("SCRIPTS", path=os.path.join("presets", "wet_cloth"))
+    path = os.path.join(user, "Sticky_Silk.py")
+    assert os.path.isfile(path)
+    assert user in installed.presets.preset_folders()
+    _preset(ob, os.path.join(folder, "Towel.py"))
+    assert s.adhesion == pytest.approx(35.0)
+    _preset(ob, path)
+    assert s.adhesion == pytest.approx(55.0) and s.density == pytest.approx(0.06)
+    with bpy.context.temp_override(active_object=ob, object=ob):
+        assert bpy.ops.wetcloth.preset_add(name="Sticky Silk", remove_active=True) == \
+            {"FINISHED"}
+    assert not os.path.exists(path)
 
 
 # ---------------------------------------------------------------------------
@@ -246,7 +297,7 @@ def test_solver_tolerance_reaches_the_world(empty_scene, cache_dir):
 
 def test_mesh_cache_plays_the_cache(draped):
     cloth, _sphere, original = draped
-    mod = cloth.modifiers["Wet Cloth Cache"]
+    mod = cloth.modifiers["Wet Cloth"]
     assert mod.type == "MESH_CACHE" and mod.cache_format == "PC2"
     assert mod.frame_start == bpy.context.scene.frame_start
     _header, frames = read_pc2(cache_path(cloth))
@@ -257,16 +308,31 @@ def test_mesh_cache_plays_the_cache(draped):
     np.testing.assert_array_equal(positions(cloth.data), original)
 
 
-def test_wetness_attributes(draped):
+def test_wetness_attributes_per_frame(draped):
+    """The baked wetness and stuck state of each frame reach the evaluated
+    mesh at that frame (as shaders and renders see it), not only the last
+    frame's: nothing is stuck while the cloth falls, part of it at the end;
+    the mesh data itself gets no attributes."""
     cloth, _sphere, _original = draped
-    attrs = cloth.data.attributes
-    wet = np.empty(len(cloth.data.vertices), np.float32)
-    attrs["wet_cloth_wetness"].data.foreach_get("value", wet)
-    np.testing.assert_allclose(wet, 1.0)
-    stuck = np.empty(len(cloth.data.vertices), np.float32)
-    attrs["wet_cloth_stuck"].data.foreach_get("value", stuck)
+    scene = bpy.context.scene
+    _header, state = read_pc2(wetness_path(cloth))
+    scene.frame_set(1)
+    np.testing.assert_allclose(evaluated_attribute(cloth, "wet_cloth_wetness"), 1.0)
+    assert evaluated_attribute(cloth, "wet_cloth_stuck").sum() == 0  # in the air
+    scene.frame_set(24)
+    stuck = evaluated_attribute(cloth, "wet_cloth_stuck")
     assert set(np.unique(stuck)) <= {0.0, 1.0}
     assert stuck.sum() > 10  # the wet cloth sticks where it lies on the sphere
+    first = int(np.argmax(state[:, :, 1].sum(axis=1) > 0))  # first frame with any stuck
+    assert 1 < first < 23, first
+    for frame in (first, first + 1, 24):
+        scene.frame_set(frame)
+        np.testing.assert_array_equal(evaluated_attribute(cloth, "wet_cloth_stuck"),
+                                      state[frame - 1, :, 1])
+        np.testing.assert_array_equal(evaluated_attribute(cloth, "wet_cloth_wetness"),
+                                      state[frame - 1, :, 0])
+    assert "wet_cloth_wetness" not in cloth.data.attributes
+    assert "wet_cloth_stuck" not in cloth.data.attributes
 
 
 def test_free_bake(draped):
@@ -275,11 +341,13 @@ def test_free_bake(draped):
     assert os.path.isfile(path)
     with bpy.context.temp_override(active_object=cloth, object=cloth):
         assert bpy.ops.wetcloth.free_bake() == {"FINISHED"}
-    assert "Wet Cloth Cache" not in cloth.modifiers
+    # the Wet Cloth modifier stays (the object is still a wet cloth), with
+    # nothing to play; the wetness modifiers go
+    assert cloth.modifiers["Wet Cloth"].filepath == ""
+    assert "Wet Cloth Wetness" not in cloth.modifiers
+    assert "Wet Cloth Attributes" not in cloth.modifiers
     assert not os.path.exists(path)
     assert os.listdir(os.path.dirname(path)) == []
-    assert "wet_cloth_wetness" not in cloth.data.attributes
-    assert "wet_cloth_stuck" not in cloth.data.attributes
     assert cloth.wet_cloth.cache_file == ""
     np.testing.assert_array_equal(evaluated_positions(cloth), original)
     # freeing again says there is nothing to free
@@ -292,11 +360,11 @@ def test_rebake_replaces(draped):
     cloth.wet_cloth.wetness = 0.0
     assert bake(cloth) == {"FINISHED"}
     assert cache_path(cloth) == first
-    assert len([m for m in cloth.modifiers if m.type == "MESH_CACHE"]) == 1
-    assert sorted(os.listdir(os.path.dirname(first))) == ["Cloth.pc2"]
-    stuck = np.empty(len(cloth.data.vertices), np.float32)
-    cloth.data.attributes["wet_cloth_stuck"].data.foreach_get("value", stuck)
-    assert stuck.sum() == 0  # dry cloth never sticks
+    assert [m.name for m in cloth.modifiers] == ["Wet Cloth Wetness", "Wet Cloth Attributes",
+                                                  "Wet Cloth"]
+    assert sorted(os.listdir(os.path.dirname(first))) == cache_names(cloth)
+    _header, state = read_pc2(wetness_path(cloth))
+    assert state[:, :, 1].sum() == 0  # dry cloth never sticks
 
 
 # ---------------------------------------------------------------------------
@@ -334,9 +402,7 @@ def test_bad_setups(empty_scene, cache_dir):
     open(blocker, "w").close()
     cloth.wet_cloth.cache_dir = os.path.join(blocker, "sub") + os.sep
     assert "cannot create the cache folder" in bake_error(cloth)
-    cloth.wet_cloth.cache_dir = "//cache/"
-    assert "not saved yet" in bake_error(cloth)
-    cloth.wet_cloth.cache_dir = cache_dir
+    cloth.wet_cloth.cache_dir = ""
 
     cloth.wet_cloth.use_scene_range = False
     cloth.wet_cloth.frame_start, cloth.wet_cloth.frame_end = 10, 10
@@ -350,8 +416,8 @@ def test_bad_setups(empty_scene, cache_dir):
     assert "no object named" in bake_error(cloth, object="missing")
     # none of these left anything behind
     assert sorted(os.listdir(cache_dir)) == ["a-file"]
-    assert "Wet Cloth Cache" not in cloth.modifiers
-    assert "wet_cloth_wetness" not in cloth.data.attributes
+    assert cloth.modifiers["Wet Cloth"].filepath == ""
+    assert "Wet Cloth Wetness" not in cloth.modifiers
 
 
 def test_failed_bake_keeps_previous(draped):
@@ -359,9 +425,10 @@ def test_failed_bake_keeps_previous(draped):
     path = cache_path(cloth)
     with open(path, "rb") as f:
         before = f.read()
-    wet_before = np.empty(len(cloth.data.vertices), np.float32)
-    cloth.data.attributes["wet_cloth_wetness"].data.foreach_get("value", wet_before)
     scene = bpy.context.scene
+    scene.frame_set(24)
+    stuck_before = evaluated_attribute(cloth, "wet_cloth_stuck")
+    files_before = {p: open(p, "rb").read() for p in (path, wetness_path(cloth))}
     scene.frame_set(7)
     # A collider whose vertex count changes over time fails the bake midway.
     build = sphere.modifiers.new("Build", "BUILD")
@@ -373,13 +440,18 @@ def test_failed_bake_keeps_previous(draped):
     assert "collider Sphere changed its vertex count" in text
     with open(path, "rb") as f:
         assert f.read() == before
-    assert os.listdir(os.path.dirname(path)) == ["Cloth.pc2"]  # no temporary file left
-    mod = cloth.modifiers["Wet Cloth Cache"]
+    for p, data in files_before.items():
+        with open(p, "rb") as f:
+            assert f.read() == data
+    # no temporary file left
+    assert sorted(os.listdir(os.path.dirname(path))) == cache_names(cloth)
+    mod = cloth.modifiers["Wet Cloth"]
     assert mod.show_viewport and bpy.path.abspath(mod.filepath) == path
-    wet = np.empty(len(cloth.data.vertices), np.float32)
-    cloth.data.attributes["wet_cloth_wetness"].data.foreach_get("value", wet)
-    np.testing.assert_array_equal(wet, wet_before)
+    assert all(m.show_viewport for m in cloth.modifiers)
     assert scene.frame_current == 7
+    scene.frame_set(24)
+    np.testing.assert_array_equal(evaluated_attribute(cloth, "wet_cloth_stuck"), stuck_before)
+    scene.frame_set(7)
     np.testing.assert_array_equal(positions(cloth.data), original)
 
 
@@ -443,7 +515,7 @@ def test_pins_follow_the_object_and_range(empty_scene, cache_dir):
                                atol=1e-5)
     free = [i for i in range(len(v)) if abs(v[i, 0]) > 0.49 and v[i, 1] < -0.49][0]
     assert frames[-1, free, 2] < v[free, 2] - 0.3
-    mod = cloth.modifiers["Wet Cloth Cache"]
+    mod = cloth.modifiers["Wet Cloth"]
     assert mod.frame_start == 5.0
     for frame in (5, 12, 20):
         empty_scene.frame_set(frame)
@@ -475,8 +547,7 @@ def test_wetness_group_and_deforming_collider(empty_scene, cache_dir):
     cloth.wet_cloth.wetness = 0.8
     cloth.wet_cloth.wetness_group = "wet"
     assert bake(cloth) == {"FINISHED"}
-    wet = np.empty(len(v), np.float32)
-    cloth.data.attributes["wet_cloth_wetness"].data.foreach_get("value", wet)
+    wet = evaluated_attribute(cloth, "wet_cloth_wetness")
     expected = np.zeros(len(v))
     expected[half] = 0.4
     np.testing.assert_allclose(wet, expected, atol=1e-6)
