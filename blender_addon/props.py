@@ -207,7 +207,7 @@ class WetClothSettings(bpy.types.PropertyGroup):
         description="Where the bake's files go, in a folder named after the .blend file. "
                     "Empty: next to the .blend file (in the temporary folder until it is saved)")
     work_limit: FloatProperty(
-        name="Work Limit", default=2000.0, soft_min=1.0, soft_max=1e5, precision=0,
+        name="Work Limit", default=500.0, soft_min=1.0, soft_max=1e5, precision=0,
         description="The largest bake that starts without asking, in millions of vertex steps "
                     "(vertices × steps per frame × frames); a larger one is refused with its "
                     "estimate and what would make it cheaper")
@@ -223,11 +223,14 @@ class WetClothSettings(bpy.types.PropertyGroup):
                                description="The point cache of the current bake")
     wetness_file: StringProperty(name="Wetness Cache", default="", subtype="FILE_PATH",
                                  description="Wetness and stuck per frame of the current bake")
-    baked_frames: IntProperty(name="Baked Frames", default=0)
-    baked_start: IntProperty(name="Baked Start", default=0)
+    baked_frames: IntProperty(name="Baked Frames", default=0,
+                              description="How many frames the current bake has")
+    baked_start: IntProperty(name="Baked Start", default=0,
+                             description="The first frame of the current bake")
     baked_inputs: StringProperty(name="Baked Inputs", default="",
                                  description="Colliders and fields of the current bake")
-    bake_info: StringProperty(name="Bake Info", default="")
+    bake_info: StringProperty(name="Bake Info", default="",
+                              description="What the current bake took")
     outdated: BoolProperty(name="Outdated", default=False,
                            description="Something that affects the result changed since the "
                                        "bake")

@@ -95,7 +95,8 @@ def build_and_bake(bpy, out, args):
 
     bpy.ops.mesh.primitive_plane_add(size=6.0, location=(0.0, 0.0, -0.32))
     bpy.context.object.data.materials.append(floor_mat)
-    cache = os.path.join(out, "cache") + os.sep
+    # saved first, so that the bakes go next to it (out/blender-demo/wetcloth_wet_cloth_demo/)
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.join(out, "wet_cloth_demo.blend"))
     for x, wetness, name in ((-0.65, 0.0, "Dry"), (0.65, 1.0, "Wet")):
         bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=0.3,
                                              location=(x, 0.0, 0.0))
@@ -115,7 +116,6 @@ def build_and_bake(bpy, out, args):
         s = cloth.wet_cloth
         s.enabled = True
         s.wetness = wetness
-        s.cache_dir = cache
         # each cloth collides with its own ball only
         coll = bpy.data.collections.new(name + " Colliders")
         scene.collection.children.link(coll)
