@@ -95,15 +95,16 @@ typedef enum wc_integrator {
     /// (XPBD, one Gauss-Seidel iteration per step, as in Macklin et al.
     /// 2019, "Small Steps in Physics Simulation"; the steps are the small
     /// substeps). Stretch stiffness no longer limits the step (any value,
-    /// up to inextensible); bending and drag still do.
+    /// up to inextensible); bending, drag and soft pins still do.
     WC_INTEGRATOR_XPBD = 1,
     /// Semi-implicit backward Euler (Choi & Ko 2002; Baraff & Witkin 1998):
-    /// the stretch links' linearised Jacobian and the bend links' axial
+    /// the stretch links' linearised Jacobian, the bend links' axial
     /// stiffness (their indefinite transverse term dropped, as Choi & Ko do)
-    /// in one linear system per step, solved by block-Jacobi preconditioned
-    /// conjugate gradients to wc_world_def.implicit_tolerance. Free fall is
-    /// exact, as with Verlet, for equal and for changing steps (solved to
-    /// round-off).
+    /// and the soft pins' goal springs, with the stretch dashpots and the air
+    /// drag, in one linear system per step, solved by block-Jacobi
+    /// preconditioned conjugate gradients to wc_world_def.implicit_tolerance.
+    /// Free fall is exact, as with Verlet, for equal and for changing steps
+    /// (solved to round-off).
     WC_INTEGRATOR_IMPLICIT = 2
 } wc_integrator;
 
