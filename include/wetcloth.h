@@ -95,15 +95,16 @@ typedef enum wc_integrator {
     /// (XPBD, one Gauss-Seidel iteration per step, as in Macklin et al.
     /// 2019, "Small Steps in Physics Simulation"; the steps are the small
     /// substeps). Stretch stiffness no longer limits the step (any value,
-    /// up to inextensible); bending and drag still do.
+    /// up to inextensible); bending, drag and soft pins still do.
     WC_INTEGRATOR_XPBD = 1,
     /// Semi-implicit backward Euler (Choi & Ko 2002; Baraff & Witkin 1998):
-    /// the stretch links' linearised Jacobian and the bend links' axial
+    /// the stretch links' linearised Jacobian, the bend links' axial
     /// stiffness (their indefinite transverse term dropped, as Choi & Ko do)
-    /// in one linear system per step, solved by block-Jacobi preconditioned
-    /// conjugate gradients to wc_world_def.implicit_tolerance. Free fall is
-    /// exact, as with Verlet, for equal and for changing steps (solved to
-    /// round-off).
+    /// and the soft pins' goal springs, with the stretch dashpots and the air
+    /// drag, in one linear system per step, solved by block-Jacobi
+    /// preconditioned conjugate gradients to wc_world_def.implicit_tolerance.
+    /// Free fall is exact, as with Verlet, for equal and for changing steps
+    /// (solved to round-off).
     WC_INTEGRATOR_IMPLICIT = 2
 } wc_integrator;
 
@@ -169,9 +170,11 @@ WC_API wc_status wc_world_advance(wc_world *world, double frame_dt, int32_t subs
 /// Largest step, s, at which the world's integrator is estimated to stay
 /// stable for every cloth in the world (an upper bound on the highest
 /// frequency of what the integrator treats explicitly, from Gershgorin's
-/// theorem, so it errs on the safe side): every link for Verlet; bend links
-/// and drag for XPBD; the dropped transverse bending term for the implicit
-/// integrator. +inf when there is no cloth.
+/// theorem, so it errs on the safe side): every link, drag and the soft
+/// pins' springs (omega^2 = their stiffness) for Verlet; bend links, drag
+/// and soft pins for XPBD; the dropped transverse bending term for the
+/// implicit integrator, which solves drag and soft pins implicitly. +inf
+/// when there is no cloth.
 WC_API double wc_world_stable_dt(const wc_world *world);
 
 /// Substeps the last wc_world_advance() used (0 before any).
@@ -218,8 +221,9 @@ typedef struct wc_material {
     /// Damping along stretch links as a fraction of each link's critical
     /// damping, [0, 1]. Default 0.05.
     double stretch_damping;
-    /// Linear air drag, N*s/m^3: force -air_drag * A_i * v on each particle.
-    /// [0, 1e4]. Default 0.02.
+    /// Linear air drag, N*s/m^3: force -air_drag * A_i * (v - u) on each
+    /// particle, u the air's velocity there (still air, u = 0, unless
+    /// wc_cloth_set_air_velocity gives one). [0, 1e4]. Default 0.02.
     double air_drag;
     /// Collision thickness of the cloth, m, [0, 1]: particles keep at least
     /// this much (plus the collider's thickness) from every surface, and at
@@ -395,7 +399,8 @@ WC_API wc_status wc_cloth_get_positions_f32(const wc_world *world, int32_t cloth
                                             float *out_xyz, int32_t count);
 
 /// Moves every particle to new positions (m, interleaved xyz, finite) with
-/// zero velocity. Pinned particles move too and stay pinned there.
+/// zero velocity. Pinned particles move too and stay pinned there: every
+/// pin's target, hard or soft, becomes its particle's new position.
 WC_API wc_status wc_cloth_set_positions(wc_world *world, int32_t cloth,
                                         const double *xyz, int32_t count);
 
@@ -447,28 +452,72 @@ typedef struct wc_cloth_view {
 /// Fills a view of a cloth's particles.
 WC_API wc_status wc_cloth_get_view(const wc_world *world, int32_t cloth, wc_cloth_view *out_view);
 
-/// Pins particles where they are now. Indices must be in range and not
-/// already pinned (nor repeated in the list). Pinned particles follow their
-/// targets and feel no forces.
+/// Pins particles where they are now (hard pins). Indices must be in range
+/// and not already pinned, hard or soft (nor repeated in the list). Hard-
+/// pinned particles follow their targets exactly and feel no forces.
 WC_API wc_status wc_cloth_pin(wc_world *world, int32_t cloth, const int32_t *indices,
                               int32_t count);
 
-/// Releases every pin.
+/// Soft-pins particles where they are now: each stays a free particle (it
+/// feels every force, collides, gets wet and sticks) and is pulled toward
+/// its pin target by a goal spring of stiffness k_i = m_i * stiffness[k]
+/// (N/m), m_i its mass (wet mass included): stiffness is the square of the
+/// particle's angular frequency about its target, 1/s^2, finite, in
+/// (0, 1e8], the same motion at any mesh resolution. Under gravity g a
+/// soft-pinned particle hangs g / stiffness below its target, and it swings
+/// about it with period 2 pi / sqrt(stiffness). indices and stiffness hold
+/// count values each; indices as for wc_cloth_pin. Soft pins join the pin
+/// list after the pins already there: wc_cloth_set_pin_targets moves them
+/// (their targets moving linearly across substeps, as hard pins do),
+/// wc_cloth_pin_count counts them and wc_cloth_unpin_all releases them.
+/// Verlet and XPBD treat the spring explicitly, so it shortens their stable
+/// step (wc_cloth_stable_dt: omega^2 = stiffness); the implicit integrator
+/// puts it in its linear system, where it costs no stability.
+WC_API wc_status wc_cloth_pin_soft(wc_world *world, int32_t cloth, const int32_t *indices,
+                                   const double *stiffness, int32_t count);
+
+/// Releases every pin, hard and soft.
 WC_API wc_status wc_cloth_unpin_all(wc_world *world, int32_t cloth);
 
-/// Number of pinned particles.
+/// Number of pins, hard and soft.
 WC_API int32_t wc_cloth_pin_count(const wc_world *world, int32_t cloth);
 
-/// Sets where the pinned particles go: one xyz target (m, finite) per pin,
+/// Sets where the pins go: one xyz target (m, finite) per pin, hard or soft,
 /// in the order the pins were added. They are reached at the end of the next
-/// wc_world_step() or wc_world_advance(), moving linearly across its substeps.
+/// wc_world_step() or wc_world_advance(), moving linearly across its
+/// substeps; a soft pin's spring pulls toward its target where it is at the
+/// start of each substep (Verlet, XPBD) or at its end (implicit).
 WC_API wc_status wc_cloth_set_pin_targets(wc_world *world, int32_t cloth,
                                           const double *targets_xyz, int32_t count);
+
+/// Sets the velocity of the air at each particle (m/s, interleaved xyz,
+/// finite, each at most 1e4 m/s long; count = the particle count), held
+/// until set again (an application that animates wind sets it every
+/// frame). The air drag then acts on the velocity relative to the air,
+/// -material.air_drag * A_i * (v_i - u_i), so a cloth in uniform wind u
+/// drifts toward u with the time constant density / air_drag (dry cloth).
+/// NULL with count 0 clears it: still air again, at no cost. With
+/// material.air_drag 0 the air velocity has no effect. Hard-pinned
+/// particles ignore it.
+WC_API wc_status wc_cloth_set_air_velocity(wc_world *world, int32_t cloth,
+                                           const double *velocity_xyz, int32_t count);
+
+/// Sets an external force on each particle as a density per rest area,
+/// N/m^2, interleaved xyz (finite, each at most 1e6 N/m^2 long; count = the
+/// particle count): particle i feels A_i * p_i with A_i its rest area (see
+/// wc_material), so the same field gives the same motion at any mesh
+/// resolution (a dry cloth accelerates by p / density). Held until set
+/// again; NULL with count 0 clears it, at no cost. Hard-pinned particles
+/// ignore it.
+WC_API wc_status wc_cloth_set_external_forces(wc_world *world, int32_t cloth,
+                                              const double *force_per_area_xyz, int32_t count);
 
 /// Largest stable step, s, for one cloth (see wc_world_stable_dt).
 WC_API double wc_cloth_stable_dt(const wc_world *world, int32_t cloth);
 
-/// Mechanical energy of a cloth, J.
+/// Mechanical energy of a cloth, J. The work of what acts from outside
+/// the cloth (drag, air velocity, external forces, soft pins' springs) is
+/// not in it.
 typedef struct wc_energy {
     /// 0.5 m v^2 with v as wc_cloth_get_velocities gives it.
     double kinetic;

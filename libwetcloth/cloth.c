@@ -20,11 +20,13 @@ void wc_cloth_destroy(wc_cloth *c)
                         c->bend_inv_rest, c->bend_coef,
                         c->link_fx, c->link_fy, c->link_fz, c->pins.from, c->pins.to,
                         c->normal_x, c->normal_y, c->normal_z, c->qx, c->qy, c->qz,
-                        c->wetness, c->wetness_next};
+                        c->wetness, c->wetness_next, c->pins.stiffness, c->air_velocity,
+                        c->external_force};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
     wc_free(c->link_start);
     wc_free(c->link_list);
     wc_free(c->pin_slot);
+    wc_free(c->soft_pin_slot);
     wc_free(c->pins.particle);
     wc_free(c->contact);
     wc_free(c->contact_prev);
@@ -123,13 +125,15 @@ static void build_link_lists(wc_cloth *c)
 
 /* What a stable step bound counts as explicit. */
 typedef enum stable_mode {
-    /* Verlet: every link, damping and drag. */
+    /* Verlet: every link, damping, drag and the soft pins' springs. */
     STABLE_ALL,
     /* XPBD: stretch links (and their damping) are constraints; the bend
-     * links' ramped buckling slope and drag remain explicit. */
+     * links' ramped buckling slope, drag and the soft pins' springs remain
+     * explicit. */
     STABLE_BEND_AND_DRAG,
-    /* Implicit: stretch, bend axial stiffness, damping and drag are in the
-     * linear system; only the bend links' transverse term, dropped from the
+    /* Implicit: stretch, bend axial stiffness, damping, drag and the soft
+     * pins' springs are in the linear system; only the bend links'
+     * transverse term, dropped from the
      * Jacobian (f/d across the link, see implicit.c), acts explicitly. Its
      * stiffness f/d is bounded by 4 pi^2 R / l^2 / (l / 2) while a bend link
      * keeps at least half its rest length, which is the bound used: a link
@@ -139,7 +143,10 @@ typedef enum stable_mode {
 
 /* Gershgorin bound on the highest angular frequency of the linearised
  * system: omega^2 <= max_i sum_links k (1/m_i + 1/sqrt(m_i m_j)), with k the
- * stretch K or the bound on the ramped buckling force's slope, 12007 R / l^3. Damping and drag
+ * stretch K or the bound on the ramped buckling force's slope, 12007 R / l^3,
+ * plus, for a soft-pinned particle that the integrator treats explicitly
+ * (Verlet, XPBD), its goal spring's k / m_i, which is the pin's stiffness
+ * itself (applied.h: k = m_i stiffness). Damping and drag
  * shorten the explicit stable step further: for a damped oscillator with
  * ratio z the limit becomes 2 (sqrt(1 + z^2) - z) / omega, and drag alone
  * needs dt < 2 m / c. */
@@ -149,9 +156,11 @@ static double estimate_stable_dt(const wc_cloth *c, stable_mode mode)
     const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
     const double bend_bound = mode == STABLE_TRANSVERSE_BEND ? 8.0 * 9.8696044010893586
                                                              : WC_BUCKLING_STIFFNESS_BOUND_RAMPED;
+    const int32_t *soft = mode != STABLE_TRANSVERSE_BEND && c->pins.soft_count ? c->soft_pin_slot
+                                                                                : NULL;
     double omega2 = 0.0;
     for (int32_t i = 0; i < n; ++i) {
-        double row = 0.0;
+        double row = soft && soft[i] >= 0 ? c->pins.stiffness[soft[i]] : 0.0;
         for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
             int32_t e = c->link_list[k] >= 0 ? c->link_list[k] : ~c->link_list[k];
             double stiffness;
@@ -188,6 +197,11 @@ static stable_mode mode_of(wc_integrator integrator)
                                                   : STABLE_ALL;
 }
 
+
+void wc_cloth_update_stable_dt(wc_cloth *c)
+{
+    c->stable_dt = estimate_stable_dt(c, mode_of(c->integrator));
+}
 
 void wc_cloth_set_integrator(wc_cloth *c, wc_integrator integrator)
 {

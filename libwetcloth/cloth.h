@@ -9,15 +9,25 @@
 #include "topology.h"
 #include "wetcloth.h"
 
-/// Pinned particles and where they move during the current advance.
+/// Pins and where their targets move during the current advance. Hard pins
+/// (wc_cloth_pin) put their particle on the target; soft pins
+/// (wc_cloth_pin_soft) pull a free particle toward it with a spring
+/// (applied.h). Both kinds share one list, in the order they were added.
 typedef struct wc_pins {
     int32_t count;
     /// Particle index of each pin, in the order they were added.
     int32_t *particle;
-    /// xyz per pin: where the pin was at the start of the advance...
+    /// xyz per pin: where the pin's target was at the start of the advance...
     double *from;
     /// ...and where it must be at its end.
     double *to;
+    /// Per pin: 0 for a hard pin, the spring's stiffness per unit mass
+    /// (1/s^2, the squared angular frequency about the target) for a soft
+    /// one. NULL until the first soft pin: a cloth with hard pins only
+    /// never has it.
+    double *stiffness;
+    /// Number of soft pins among the count.
+    int32_t soft_count;
 } wc_pins;
 
 typedef struct wc_cloth {
@@ -62,9 +72,20 @@ typedef struct wc_cloth {
     int32_t *link_start;
     int32_t *link_list;
 
-    /// Pin slot of each particle, or -1 when free.
+    /// Hard pin slot of each particle, or -1 when it moves by its forces
+    /// (free, or soft-pinned).
     int32_t *pin_slot;
+    /// Soft pin slot of each particle, or -1 (NULL until the first soft pin).
+    int32_t *soft_pin_slot;
     wc_pins pins;
+
+    /* Applied forces (applied.h), each NULL until the application sets it:
+     * a cloth that has none pays nothing for them. */
+    /// Velocity of the air at each particle, m/s, interleaved xyz.
+    double *air_velocity;
+    /// External force on each particle, N, interleaved xyz: the force
+    /// density given (N/m^2) times the particle's rest area.
+    double *external_force;
 
     /// The world's integrator (set when the cloth joins a world).
     wc_integrator integrator;
@@ -144,6 +165,10 @@ void wc_cloth_apply_material(wc_cloth *cloth);
 /// Sets the integrator that will step the cloth, and the stable step
 /// estimate with it.
 void wc_cloth_set_integrator(wc_cloth *cloth, wc_integrator integrator);
+
+/// Recomputes the stable step estimate, after the explicit forces changed
+/// (soft pins added or released).
+void wc_cloth_update_stable_dt(wc_cloth *cloth);
 
 /// Velocity of particle i, m/s (see wc_cloth_get_velocities).
 void wc_cloth_velocity(const wc_cloth *cloth, int32_t i, double v[3]);

@@ -11,6 +11,9 @@
 #include "world.h"
 
 #define MAX_VERTICES (1 << 26)
+/* A soft pin's largest stiffness, 1/s^2: an angular frequency of 1e4 rad/s,
+ * far stiffer than any goal a scene needs, with k (x - T) still finite. */
+#define MAX_PIN_STIFFNESS 1e8
 #define MAX_FACES (1 << 27)
 
 wc_mesh_cloth_def wc_mesh_cloth_def_default(void)
@@ -375,23 +378,29 @@ wc_status wc_cloth_get_view(const wc_world *w, int32_t cloth, wc_cloth_view *out
 /* ------------------------------------------------------------------------ */
 
 /* Checks a pin list completely before anything changes: range, pinned
- * already, repeated in the list. */
-static wc_status validate_pins(const wc_world *w, wc_cloth *c, const int32_t *idx, int32_t count)
+ * already (hard or soft), repeated in the list. Marks each listed particle
+ * in pin_slot for the repeat check; undo_pin_marks takes the marks away. */
+static wc_status validate_pins(const wc_world *w, wc_cloth *c, const int32_t *idx, int32_t count,
+                               const char *caller)
 {
     wc_message *msg = wc_world_message(w);
     if (count < 0 || (int64_t)count + c->pins.count > c->particle_count)
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
-                       "wc_cloth_pin: count must be in [0, %d] (unpinned particles) but is %d",
+                       "%s: count must be in [0, %d] (unpinned particles) but is %d", caller,
                        (int)(c->particle_count - c->pins.count), (int)count);
     for (int32_t k = 0; k < count; ++k) {
         int32_t i = idx[k];
         if (i < 0 || i >= c->particle_count)
             return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
-                           "wc_cloth_pin: indices[%d] is %d, but the cloth has %d particles",
+                           "%s: indices[%d] is %d, but the cloth has %d particles", caller,
                            (int)k, (int)i, (int)c->particle_count);
-        if (c->pin_slot[i] >= 0)
+        if (c->soft_pin_slot && c->soft_pin_slot[i] >= 0)
             return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
-                           "wc_cloth_pin: indices[%d] = %d is %s", (int)k, (int)i,
+                           "%s: indices[%d] = %d is already pinned (soft pin %d)", caller, (int)k,
+                           (int)i, (int)c->soft_pin_slot[i]);
+        if (c->pin_slot[i] >= 0)
+            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s: indices[%d] = %d is %s", caller,
+                           (int)k, (int)i,
                            c->pin_slot[i] < c->pins.count ? "already pinned"
                                                           : "repeated in the list");
         c->pin_slot[i] = c->pins.count + k; /* marks it for the duplicate check */
@@ -406,49 +415,129 @@ static void undo_pin_marks(wc_cloth *c, const int32_t *idx, int32_t count)
             c->pin_slot[idx[k]] = -1;
 }
 
-wc_status wc_cloth_pin(wc_world *w, int32_t cloth, const int32_t *idx, int32_t count)
+/* Each soft pin's stiffness, 1/s^2, finite, in (0, 1e8]. */
+static wc_status validate_stiffness(const wc_world *w, const int32_t *idx, const double *stiffness,
+                                    int32_t count)
 {
-    wc_cloth *c = cloth_with_count(w, cloth, idx, count, -1, "wc_cloth_pin");
-    if (!c) return lookup_status(w, cloth);
-    wc_status s = validate_pins(w, c, idx, count);
-    int32_t total = c->pins.count + count;
-    int32_t *particle = NULL;
-    double *from = NULL, *to = NULL;
-    if (!s) {
-        particle = wc_alloc_array((size_t)total, sizeof *particle);
-        from = wc_alloc_array(3 * (size_t)total, sizeof *from);
-        to = wc_alloc_array(3 * (size_t)total, sizeof *to);
-        if (!particle || !from || !to)
-            s = wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory pinning %d particles",
-                        (int)count);
+    for (int32_t k = 0; k < count; ++k)
+        if (!(stiffness[k] > 0.0 && stiffness[k] <= MAX_PIN_STIFFNESS))
+            return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+                           "wc_cloth_pin_soft: stiffness[%d] (for particle %d) must be in "
+                           "(0, %g] 1/s^2 but is %g",
+                           (int)k, (int)idx[k], MAX_PIN_STIFFNESS, stiffness[k]);
+    return WC_OK;
+}
+
+/* The pin arrays grown by count pins: NULL stiffness adds hard pins, else
+ * soft ones. Allocates everything first; on failure the cloth is as it was. */
+typedef struct grown_pins {
+    int32_t *particle, *soft_pin_slot;
+    double *from, *to, *stiffness;
+} grown_pins;
+
+static void free_grown(grown_pins *g)
+{
+    wc_free(g->particle);
+    wc_free(g->from);
+    wc_free(g->to);
+    wc_free(g->stiffness);
+    wc_free(g->soft_pin_slot);
+}
+
+static int allocate_grown(const wc_cloth *c, int32_t total, int soft, grown_pins *g)
+{
+    memset(g, 0, sizeof *g);
+    g->particle = wc_alloc_array((size_t)total, sizeof *g->particle);
+    g->from = wc_alloc_array(3 * (size_t)total, sizeof *g->from);
+    g->to = wc_alloc_array(3 * (size_t)total, sizeof *g->to);
+    int ok = g->particle && g->from && g->to;
+    /* a cloth that ever had a soft pin keeps a stiffness per pin */
+    if (soft || c->pins.stiffness) {
+        g->stiffness = wc_alloc_array((size_t)total, sizeof *g->stiffness);
+        ok &= g->stiffness != NULL;
     }
-    if (s) {
-        undo_pin_marks(c, idx, count);
-        wc_free(particle);
-        wc_free(from);
-        wc_free(to);
-        return s;
+    if (soft && !c->soft_pin_slot) {
+        g->soft_pin_slot = wc_alloc_array((size_t)c->particle_count, sizeof *g->soft_pin_slot);
+        ok &= g->soft_pin_slot != NULL;
     }
-    if (c->pins.count) {
-        memcpy(particle, c->pins.particle, (size_t)c->pins.count * sizeof *particle);
-        memcpy(from, c->pins.from, 3 * (size_t)c->pins.count * sizeof *from);
-        memcpy(to, c->pins.to, 3 * (size_t)c->pins.count * sizeof *to);
+    if (!ok) free_grown(g);
+    return ok;
+}
+
+/* Moves the grown arrays in, the new pins after the old ones, each pin's
+ * target where its particle is now. */
+static void install_pins(wc_cloth *c, grown_pins *g, const int32_t *idx, const double *stiffness,
+                         int32_t count)
+{
+    int32_t old = c->pins.count, total = old + count;
+    if (old) {
+        memcpy(g->particle, c->pins.particle, (size_t)old * sizeof *g->particle);
+        memcpy(g->from, c->pins.from, 3 * (size_t)old * sizeof *g->from);
+        memcpy(g->to, c->pins.to, 3 * (size_t)old * sizeof *g->to);
+        if (c->pins.stiffness) memcpy(g->stiffness, c->pins.stiffness, (size_t)old * sizeof(double));
+    }
+    if (g->stiffness && !c->pins.stiffness)
+        for (int32_t p = 0; p < old; ++p) g->stiffness[p] = 0.0; /* the hard pins so far */
+    if (g->soft_pin_slot) {
+        for (int32_t i = 0; i < c->particle_count; ++i) g->soft_pin_slot[i] = -1;
+        c->soft_pin_slot = g->soft_pin_slot;
     }
     for (int32_t k = 0; k < count; ++k) {
-        int32_t p = c->pins.count + k, i = idx[k];
-        particle[p] = i;
-        from[3 * p] = to[3 * p] = c->x[i];
-        from[3 * p + 1] = to[3 * p + 1] = c->y[i];
-        from[3 * p + 2] = to[3 * p + 2] = c->z[i];
+        int32_t p = old + k, i = idx[k];
+        g->particle[p] = i;
+        g->from[3 * p] = g->to[3 * p] = c->x[i];
+        g->from[3 * p + 1] = g->to[3 * p + 1] = c->y[i];
+        g->from[3 * p + 2] = g->to[3 * p + 2] = c->z[i];
+        if (g->stiffness) g->stiffness[p] = stiffness ? stiffness[k] : 0.0;
+        if (stiffness)
+            c->soft_pin_slot[i] = p, c->pin_slot[i] = -1;
+        else
+            c->pin_slot[i] = p;
     }
     wc_free(c->pins.particle);
     wc_free(c->pins.from);
     wc_free(c->pins.to);
-    c->pins.particle = particle;
-    c->pins.from = from;
-    c->pins.to = to;
+    if (g->stiffness) wc_free(c->pins.stiffness);
+    c->pins.particle = g->particle;
+    c->pins.from = g->from;
+    c->pins.to = g->to;
+    if (g->stiffness) c->pins.stiffness = g->stiffness;
     c->pins.count = total;
+    if (stiffness) c->pins.soft_count += count;
+}
+
+/* Adds hard pins or (soft = 1) soft pins with the given stiffness. */
+static wc_status add_pins(wc_world *w, int32_t cloth, const int32_t *idx, int soft,
+                          const double *stiffness, int32_t count, const char *caller)
+{
+    wc_cloth *c = cloth_with_count(w, cloth, idx, count, -1, caller);
+    if (!c) return lookup_status(w, cloth);
+    if (soft && !stiffness)
+        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "%s: the stiffness array is NULL",
+                       caller);
+    wc_status s = validate_pins(w, c, idx, count, caller);
+    if (!s && soft) s = validate_stiffness(w, idx, stiffness, count);
+    grown_pins g;
+    if (!s && !allocate_grown(c, c->pins.count + count, soft, &g))
+        s = wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory pinning %d particles",
+                    (int)count);
+    undo_pin_marks(c, idx, count);
+    if (s) return s;
+    install_pins(c, &g, idx, soft ? stiffness : NULL, count);
+    /* the springs are explicit forces for Verlet and XPBD */
+    if (soft) wc_cloth_update_stable_dt(c);
     return WC_OK;
+}
+
+wc_status wc_cloth_pin(wc_world *w, int32_t cloth, const int32_t *idx, int32_t count)
+{
+    return add_pins(w, cloth, idx, 0, NULL, count, "wc_cloth_pin");
+}
+
+wc_status wc_cloth_pin_soft(wc_world *w, int32_t cloth, const int32_t *idx, const double *stiffness,
+                            int32_t count)
+{
+    return add_pins(w, cloth, idx, 1, stiffness, count, "wc_cloth_pin_soft");
 }
 
 wc_status wc_cloth_unpin_all(wc_world *w, int32_t cloth)
@@ -456,8 +545,15 @@ wc_status wc_cloth_unpin_all(wc_world *w, int32_t cloth)
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
     wc_cloth *c = wc_world_find_cloth(w, cloth, "wc_cloth_unpin_all");
     if (!c) return WC_ERROR_NOT_FOUND;
-    for (int32_t p = 0; p < c->pins.count; ++p) c->pin_slot[c->pins.particle[p]] = -1;
+    for (int32_t p = 0; p < c->pins.count; ++p) {
+        int32_t i = c->pins.particle[p];
+        c->pin_slot[i] = -1;
+        if (c->soft_pin_slot) c->soft_pin_slot[i] = -1;
+    }
+    int had_soft = c->pins.soft_count > 0;
     c->pins.count = 0;
+    c->pins.soft_count = 0;
+    if (had_soft) wc_cloth_update_stable_dt(c);
     return WC_OK;
 }
 

@@ -231,16 +231,29 @@ static int start_velocities_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
+/* A soft pin's goal spring k = m s, N/m (applied.c), or 0 for a particle
+ * without one; soft_pin_slot is NULL when the cloth has no soft pin. */
+static double goal_stiffness(const wc_cloth *c, const int32_t *soft_pin_slot, int64_t i)
+{
+    if (!soft_pin_slot || soft_pin_slot[i] < 0) return 0.0;
+    return c->mass[i] * c->pins.stiffness[soft_pin_slot[i]];
+}
+
 /* Per free particle, gathered over its links in their fixed order: the
  * right-hand side h f_i + h^2 (df/dx v0)_i plus what the pins' known dv
  * contribute, and the preconditioner (the inverse diagonal block). Pinned
- * rows are zero: their dv is known, not solved for. */
+ * rows are zero: their dv is known, not solved for. A soft pin's goal
+ * spring, -k (x - T) with df/dx = -k I, enters as a link to a fixed point
+ * does: share h^2 k on the diagonal (in mass_diag, which the product and
+ * the coarse levels read) and -h^2 k v0 on the right-hand side; its force
+ * at x, toward the target at the step's end, is already in f. */
 static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t end)
 {
     const implicit_pass *pass = context;
     const wc_cloth *c = pass->cloth;
     wc_implicit_state *s = pass->state;
     double h = pass->h, drag = c->material.air_drag, h2 = h * h;
+    const int32_t *soft = c->pins.soft_count ? c->soft_pin_slot : NULL;
     for (int64_t i = begin; i < end; ++i) {
         double *b = s->rhs + 3 * (size_t)i, *pre = s->precond + 6 * (size_t)i;
         if (c->pin_slot[i] >= 0) {
@@ -249,9 +262,15 @@ static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t en
             continue;
         }
         double md = c->mass[i] + (drag > 0.0 ? h * drag * c->topology.area[i] : 0.0);
+        double bx = h * c->fx[i], by = h * c->fy[i], bz = h * c->fz[i];
+        double goal = goal_stiffness(c, soft, i);
+        if (goal > 0.0) {
+            const double *v = s->v0 + 3 * (size_t)i;
+            md += pass->share * h2 * goal;
+            bx -= h2 * goal * v[0], by -= h2 * goal * v[1], bz -= h2 * goal * v[2];
+        }
         s->mass_diag[i] = md;
         double diag[6] = {md, 0.0, 0.0, md, 0.0, md};
-        double bx = h * c->fx[i], by = h * c->fy[i], bz = h * c->fz[i];
         for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
             int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
             int32_t j = entry >= 0 ? s->end_b[e] : s->end_a[e];
@@ -467,12 +486,21 @@ static double precondition(implicit_pass *pass, int threads)
 }
 
 /* The mass the solve's free particles carry, kg: with the step's
- * velocity tolerance it makes the bound on the error's energy norm. */
-static double free_mass(const wc_cloth *c, const wc_implicit_state *s)
+ * velocity tolerance it makes the bound on the error's energy norm. The
+ * goal springs' share of the diagonal is stiffness, not mass: counted, it
+ * would loosen the bound (by sqrt(1 + h^2 s) on a cloth soft-pinned all
+ * over). */
+static double free_mass(const implicit_pass *pass)
 {
-    double mass = 0.0;
-    for (int32_t i = 0; i < s->n; ++i)
-        if (c->pin_slot[i] < 0) mass += s->mass_diag[i];
+    const wc_cloth *c = pass->cloth;
+    const wc_implicit_state *s = pass->state;
+    const int32_t *soft = c->pins.soft_count ? c->soft_pin_slot : NULL;
+    double mass = 0.0, spring = pass->share * (pass->h * pass->h);
+    for (int32_t i = 0; i < s->n; ++i) {
+        if (c->pin_slot[i] >= 0) continue;
+        double goal = goal_stiffness(c, soft, i);
+        mass += goal > 0.0 ? s->mass_diag[i] - spring * goal : s->mass_diag[i];
+    }
     return mass;
 }
 
@@ -504,7 +532,7 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
         double rz = precondition(pass, threads);
         memcpy(s->p, s->z, bytes);
         double bound = velocity_tolerance > 0.0 ? velocity_tolerance * velocity_tolerance *
-                                                      free_mass(pass->cloth, s)
+                                                      free_mass(pass)
                                                 : 0.0;
         double decrease[ESTIMATE_DELAY] = {0.0};
         for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {

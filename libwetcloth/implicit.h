@@ -2,10 +2,11 @@
  * Witkin 1998 and Choi & Ko 2002: one linear solve per step,
  *   (M - h df/dv - s h^2 df/dx) dv = h (f + h df/dx v),  x+ = x + h (v + s dv),
  * s = (h + h_prev) / 2h (1 with equal steps),
- * with df/dx the stretch links' Jacobian (tension only) and the bend
- * links' axial stiffness (their transverse term dropped, as Choi & Ko do,
- * because it would make the matrix indefinite), df/dv the stretch dashpots
- * and air drag. Block-Jacobi preconditioned conjugate gradients (with coarse
+ * with df/dx the stretch links' Jacobian (tension only), the bend links'
+ * axial stiffness (their transverse term dropped, as Choi & Ko do, because
+ * it would make the matrix indefinite) and the soft pins' goal springs,
+ * df/dv the stretch dashpots and air drag (relative to the air: its
+ * velocity's part of the drag is constant and enters f alone). Block-Jacobi preconditioned conjugate gradients (with coarse
  * levels on large cloths, multigrid.h), stopped at an estimated velocity
  * error of wc_world_def.implicit_tolerance times the step, matrix-free,
  * gathered per particle with fixed-order reductions: the same bits for any

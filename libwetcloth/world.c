@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "applied.h"
 #include "clock.h"
 #include "cloth_group.h"
 #include "collide.h"
@@ -280,20 +281,28 @@ static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_f
                    "last good state", (int)c);
 }
 
-/* One step of the whole world, top to bottom: forces (with the wet pull of
- * the last step's contacts), integration, collisions (with colliders, then
- * each cloth with itself; wet friction acts in their response), the wet
- * response (stuck particles), the commit, and the wetness dynamics. Nothing
- * is committed unless every cloth's new state is finite, so a failed step
- * leaves the world exactly as it was. */
-static wc_status world_step(wc_world *w, double dt, double share, double pin_fraction)
+/* One step of the whole world, top to bottom: forces (with the applied
+ * forces and the wet pull of the last step's contacts), integration,
+ * collisions (with colliders, then each cloth with itself; wet friction
+ * acts in their response), the wet response (stuck particles), the commit,
+ * and the wetness dynamics. Nothing is committed unless every cloth's new
+ * state is finite, so a failed step leaves the world exactly as it was.
+ * The pins are at pin_start of the way to their targets when the step
+ * starts and at pin_fraction when it ends. */
+static wc_status world_step(wc_world *w, double dt, double share, double pin_start,
+                            double pin_fraction)
 {
     int threads = wc_thread_count(w->def.thread_count);
     memset(&w->stats, 0, sizeof w->stats);
     double *phase = w->phase_seconds, t0 = wc_clock_seconds(), t1;
+    /* soft pins pull toward where their targets are when the integrator
+     * evaluates forces: the step's start, or its end for backward Euler */
+    double goal_fraction = w->def.integrator == WC_INTEGRATOR_IMPLICIT ? pin_fraction : pin_start;
     for (int32_t c = 0; c < w->cloth_count; ++c) {
-        wc_forces_compute(w->cloths[c], w->def.gravity, threads);
-        if (w->cloths[c]->wet_forces) wc_wet_forces(w->cloths[c], threads);
+        wc_cloth *cl = w->cloths[c];
+        wc_forces_compute(cl, w->def.gravity, threads);
+        if (wc_applied_active(cl)) wc_applied_forces_add(cl, goal_fraction, threads);
+        if (cl->wet_forces) wc_wet_forces(cl, threads);
     }
     /* wet cloths sticking to each other: after every cloth's own forces */
     wc_cloth_group_adhesion(w->group, w->cloths);
@@ -356,16 +365,25 @@ static void finish_timing(wc_world *w)
     w->stats.solver_iterations = w->solver_iterations;
 }
 
-/* After an advance, pins start the next one from where they are. A
- * complete advance has brought them to their targets; after a failed one
- * they keep their targets, so the next advance still takes them there. */
-static void settle_pins(wc_world *w)
+/* After an advance, pins start the next one from where they are: a hard
+ * pin where its particle is, a soft pin where its target was at the end of
+ * the last good step, `reached` of the way from `from` to `to` (a soft-
+ * pinned particle is not on its target). A complete advance has brought
+ * them to their targets; after a failed one they keep their targets, so the
+ * next advance still takes them there. */
+static void settle_pins(wc_world *w, double reached)
 {
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_cloth *cl = w->cloths[c];
         for (int32_t p = 0; p < cl->pins.count; ++p) {
             int32_t i = cl->pins.particle[p];
             double *from = cl->pins.from + 3 * (size_t)p;
+            if (cl->pins.stiffness && cl->pins.stiffness[p] > 0.0) {
+                double target[3];
+                wc_pinned_position(cl, p, reached, target);
+                from[0] = target[0], from[1] = target[1], from[2] = target[2];
+                continue;
+            }
             from[0] = cl->x[i];
             from[1] = cl->y[i];
             from[2] = cl->z[i];
@@ -387,9 +405,9 @@ wc_status wc_world_step(wc_world *w, double dt)
     wc_status s = check_step_length(w, "wc_world_step: dt", dt);
     if (s) return s;
     start_timing(w);
-    s = world_step(w, dt, 1.0, 1.0);
+    s = world_step(w, dt, 1.0, 0.0, 1.0);
     finish_timing(w);
-    settle_pins(w);
+    settle_pins(w, s ? 0.0 : 1.0);
     return s;
 }
 
@@ -422,10 +440,15 @@ wc_status wc_world_advance(wc_world *w, double frame_dt, int32_t substeps)
     }
     double dt = frame_dt / substeps;
     start_timing(w);
-    for (int32_t k = 0; k < substeps && !s; ++k)
-        s = world_step(w, dt, 1.0 / (substeps - k), (double)(k + 1) / substeps);
+    int32_t done = 0; /* substeps that succeeded */
+    while (done < substeps) {
+        s = world_step(w, dt, 1.0 / (substeps - done), (double)done / substeps,
+                       (double)(done + 1) / substeps);
+        if (s) break;
+        ++done;
+    }
     finish_timing(w);
-    settle_pins(w);
+    settle_pins(w, done == substeps ? 1.0 : (double)done / substeps);
     w->last_substeps = substeps;
     return s;
 }

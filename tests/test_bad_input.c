@@ -54,6 +54,9 @@ static void check_twins(const char *after)
         CHECK(wc_world_time(wa) == wc_world_time(wb), "after %s: time %.17g vs %.17g", after,
               wc_world_time(wa), wc_world_time(wb));
         CHECK(wc_cloth_pin_count(wa, ca) == wc_cloth_pin_count(wb, cb), "after %s: pin count", after);
+        CHECK(wc_cloth_stable_dt(wa, ca) == wc_cloth_stable_dt(wb, cb),
+              "after %s: stable step %.17g vs %.17g", after, wc_cloth_stable_dt(wa, ca),
+              wc_cloth_stable_dt(wb, cb));
         if (round == 0) {
             CHECK(wc_world_step(wa, DT) == WC_OK, "after %s: world a does not step: %s", after,
                   wc_world_last_error(wa));
@@ -130,6 +133,11 @@ static void test_null_world(void)
     CHECK(wc_cloth_particle_count(NULL, 0) == 0, "count(NULL)");
     CHECK(wc_world_cloth_count(NULL) == 0, "cloth_count(NULL)");
     CHECK(wc_world_last_error(NULL) != NULL, "last_error(NULL)");
+    int32_t idx[1] = {0};
+    double stiffness[1] = {1.0};
+    CHECK(wc_cloth_pin_soft(NULL, 0, idx, stiffness, 1) == WC_ERROR_INVALID_ARGUMENT, "pin_soft(NULL)");
+    CHECK(wc_cloth_set_air_velocity(NULL, 0, xyz, COUNT) == WC_ERROR_INVALID_ARGUMENT, "air(NULL)");
+    CHECK(wc_cloth_set_external_forces(NULL, 0, xyz, COUNT) == WC_ERROR_INVALID_ARGUMENT, "forces(NULL)");
     wc_world_destroy(NULL);
 }
 
@@ -392,6 +400,106 @@ static void test_pins(void)
     expect(wc_cloth_set_pin_targets(wa, ca, targets, 5), WC_ERROR_INVALID_ARGUMENT, "set_pin_targets NaN", "finite", NULL);
 }
 
+/* Soft pins share the pin list and its checks, and add their stiffness.
+ * Both twins get soft pins 10 and 11 first, so that a failed call must
+ * also leave existing soft pins (their springs pull in every later step)
+ * as they were. */
+static void test_soft_pins(void)
+{
+    int32_t first[2] = {10, 11};
+    double first_stiffness[2] = {50.0, 80.0};
+    CHECK(wc_cloth_pin_soft(wa, ca, first, first_stiffness, 2) == WC_OK, "pin_soft: %s", wc_world_last_error(wa));
+    CHECK(wc_cloth_pin_soft(wb, cb, first, first_stiffness, 2) == WC_OK, "twin pin_soft");
+    check_twins("soft-pinning 10, 11");
+    double s3[3] = {10.0, 10.0, 10.0};
+    int32_t bad_range[2] = {1, 500};
+    expect(wc_cloth_pin_soft(wa, ca, bad_range, s3, 2), WC_ERROR_INVALID_ARGUMENT, "pin_soft {1, 500}", "indices[1]", "500");
+    int32_t negative[1] = {-3};
+    expect(wc_cloth_pin_soft(wa, ca, negative, s3, 1), WC_ERROR_INVALID_ARGUMENT, "pin_soft {-3}", "indices[0]", "-3");
+    int32_t dup[3] = {20, 21, 20};
+    expect(wc_cloth_pin_soft(wa, ca, dup, s3, 3), WC_ERROR_INVALID_ARGUMENT, "pin_soft {20, 21, 20}", "indices[2]", "repeated");
+    int32_t hard[2] = {22, COUNT - 1};
+    expect(wc_cloth_pin_soft(wa, ca, hard, s3, 2), WC_ERROR_INVALID_ARGUMENT, "pin_soft {22, 63} (63 pinned)", "indices[1] = 63", "already pinned");
+    int32_t soft[2] = {22, 11};
+    expect(wc_cloth_pin_soft(wa, ca, soft, s3, 2), WC_ERROR_INVALID_ARGUMENT, "pin_soft {22, 11} (11 soft)", "indices[1] = 11", "already pinned (soft pin");
+    expect(wc_cloth_pin(wa, ca, soft, 2), WC_ERROR_INVALID_ARGUMENT, "pin {22, 11} (11 soft)", "indices[1] = 11", "already pinned (soft pin");
+    expect(wc_cloth_pin_soft(wa, ca, dup, s3, -1), WC_ERROR_INVALID_ARGUMENT, "pin_soft count -1", "count", NULL);
+    expect(wc_cloth_pin_soft(wa, ca, dup, NULL, 2), WC_ERROR_INVALID_ARGUMENT, "pin_soft stiffness NULL", "stiffness", "NULL");
+    expect(wc_cloth_pin_soft(wa, ca, NULL, s3, 2), WC_ERROR_INVALID_ARGUMENT, "pin_soft indices NULL", "NULL", NULL);
+    const double bad_stiffness[] = {0.0, -5.0, NAN, INFINITY, 1.5e8};
+    const char *shown[] = {"is 0", "is -5", "is nan", "is inf", "is 1.5e+08"};
+    for (int k = 0; k < 5; ++k) {
+        int32_t idx[3] = {20, 21, 22};
+        double stiff[3] = {10.0, 10.0, 10.0};
+        stiff[2] = bad_stiffness[k];
+        char call[64];
+        snprintf(call, sizeof call, "pin_soft stiffness[2] = %g", bad_stiffness[k]);
+        expect(wc_cloth_pin_soft(wa, ca, idx, stiff, 3), WC_ERROR_INVALID_ARGUMENT, call,
+               "stiffness[2] (for particle 22)", shown[k]);
+    }
+    /* none of the rejected lists left a mark: 20, 21, 22 can be soft-pinned now */
+    int32_t ok[3] = {20, 21, 22};
+    CHECK(wc_cloth_pin_soft(wa, ca, ok, s3, 3) == WC_OK, "pin_soft {20, 21, 22} after rejections: %s", wc_world_last_error(wa));
+    CHECK(wc_cloth_pin_soft(wb, cb, ok, s3, 3) == WC_OK, "twin pin_soft");
+    CHECK(wc_cloth_pin_count(wa, ca) == 10, "pin count %d (5 hard, 5 soft)", wc_cloth_pin_count(wa, ca));
+    check_twins("soft-pinning 20, 21, 22");
+    /* the largest stiffness is allowed */
+    int32_t last = 30;
+    double most = 1e8;
+    CHECK(wc_cloth_pin_soft(wa, ca, &last, &most, 1) == WC_OK && wc_cloth_pin_soft(wb, cb, &last, &most, 1) == WC_OK,
+          "stiffness 1e8: %s", wc_world_last_error(wa));
+    double targets[3 * 12] = {0};
+    expect(wc_cloth_set_pin_targets(wa, ca, targets, 10), WC_ERROR_INVALID_ARGUMENT, "set_pin_targets count 10 of 11 (soft too)", "count", "11");
+}
+
+/* Air velocity and external force densities: the count, finiteness and
+ * length of every vector checked before anything changes. The twins get
+ * a valid field first, so that a failed call must keep it as it was. */
+static void test_fields(void)
+{
+    double u[3 * COUNT], p[3 * COUNT];
+    for (int32_t k = 0; k < 3 * COUNT; ++k) u[k] = 0.5 + 0.01 * k, p[k] = -0.2 + 0.003 * k;
+    CHECK(wc_cloth_set_air_velocity(wa, ca, u, COUNT) == WC_OK && wc_cloth_set_air_velocity(wb, cb, u, COUNT) == WC_OK,
+          "air: %s", wc_world_last_error(wa));
+    CHECK(wc_cloth_set_external_forces(wa, ca, p, COUNT) == WC_OK && wc_cloth_set_external_forces(wb, cb, p, COUNT) == WC_OK,
+          "forces: %s", wc_world_last_error(wa));
+    check_twins("setting air velocity and external forces");
+
+    double bad[3 * (COUNT + 1)];
+    memcpy(bad, u, sizeof u);
+    expect(wc_cloth_set_air_velocity(wa, ca, bad, COUNT - 1), WC_ERROR_INVALID_ARGUMENT, "air count 63", "count", "64");
+    expect(wc_cloth_set_air_velocity(wa, ca, bad, COUNT + 1), WC_ERROR_INVALID_ARGUMENT, "air count 65", "count", "64");
+    expect(wc_cloth_set_air_velocity(wa, ca, bad, 0), WC_ERROR_INVALID_ARGUMENT, "air count 0 (not NULL)", "count", "64");
+    expect(wc_cloth_set_air_velocity(wa, ca, NULL, COUNT), WC_ERROR_INVALID_ARGUMENT, "air NULL, count 64", "NULL", "count 0 clears");
+    bad[3 * 7 + 1] = NAN;
+    expect(wc_cloth_set_air_velocity(wa, ca, bad, COUNT), WC_ERROR_INVALID_ARGUMENT, "air NaN", "velocity_xyz[22] (y of particle 7)", "finite");
+    bad[3 * 7 + 1] = -INFINITY;
+    expect(wc_cloth_set_air_velocity(wa, ca, bad, COUNT), WC_ERROR_INVALID_ARGUMENT, "air -inf", "particle 7", "-inf");
+    memcpy(bad, u, sizeof u);
+    bad[3 * 60] = 8000.0, bad[3 * 60 + 1] = 7000.0; /* each below 1e4, together 10630 m/s */
+    expect(wc_cloth_set_air_velocity(wa, ca, bad, COUNT), WC_ERROR_INVALID_ARGUMENT, "air 10630 m/s", "particle 60", "at most 10000 m/s");
+
+    memcpy(bad, p, sizeof p);
+    expect(wc_cloth_set_external_forces(wa, ca, bad, COUNT - 1), WC_ERROR_INVALID_ARGUMENT, "forces count 63", "count", "64");
+    expect(wc_cloth_set_external_forces(wa, ca, NULL, 5), WC_ERROR_INVALID_ARGUMENT, "forces NULL, count 5", "NULL", NULL);
+    bad[3 * 12 + 2] = INFINITY;
+    expect(wc_cloth_set_external_forces(wa, ca, bad, COUNT), WC_ERROR_INVALID_ARGUMENT, "forces inf", "force_per_area_xyz[38] (z of particle 12)", "finite");
+    memcpy(bad, p, sizeof p);
+    bad[3 * 40 + 2] = -2e6;
+    expect(wc_cloth_set_external_forces(wa, ca, bad, COUNT), WC_ERROR_INVALID_ARGUMENT, "forces 2e6 N/m^2", "particle 40", "at most 1e+06 N/m^2");
+
+    /* the limits themselves are allowed; clearing gives still air and no
+     * force again, on both twins */
+    memcpy(bad, u, sizeof u);
+    bad[0] = 1e4, bad[1] = bad[2] = 0.0;
+    CHECK(wc_cloth_set_air_velocity(wa, ca, bad, COUNT) == WC_OK && wc_cloth_set_air_velocity(wb, cb, bad, COUNT) == WC_OK,
+          "air at 1e4 m/s: %s", wc_world_last_error(wa));
+    CHECK(wc_cloth_set_air_velocity(wa, ca, NULL, 0) == WC_OK && wc_cloth_set_air_velocity(wb, cb, NULL, 0) == WC_OK &&
+              wc_cloth_set_external_forces(wa, ca, NULL, 0) == WC_OK && wc_cloth_set_external_forces(wb, cb, NULL, 0) == WC_OK,
+          "clearing: %s", wc_world_last_error(wa));
+    check_twins("clearing the fields");
+}
+
 static void test_arrays(void)
 {
     double xyz[3 * (COUNT + 1)];
@@ -434,6 +542,11 @@ static void test_unknown_cloth(void)
         expect(wc_cloth_pin(wa, c, idx, 1), WC_ERROR_NOT_FOUND, "pin(unknown)", num, NULL);
         expect(wc_cloth_unpin_all(wa, c), WC_ERROR_NOT_FOUND, "unpin_all(unknown)", num, NULL);
         expect(wc_cloth_set_pin_targets(wa, c, xyz, 2), WC_ERROR_NOT_FOUND, "set_pin_targets(unknown)", num, NULL);
+        double stiffness[1] = {1.0};
+        expect(wc_cloth_pin_soft(wa, c, idx, stiffness, 1), WC_ERROR_NOT_FOUND, "pin_soft(unknown)", num, NULL);
+        expect(wc_cloth_set_air_velocity(wa, c, xyz, COUNT), WC_ERROR_NOT_FOUND, "set_air_velocity(unknown)", num, NULL);
+        expect(wc_cloth_set_air_velocity(wa, c, NULL, 0), WC_ERROR_NOT_FOUND, "set_air_velocity(unknown, clear)", num, NULL);
+        expect(wc_cloth_set_external_forces(wa, c, xyz, COUNT), WC_ERROR_NOT_FOUND, "set_external_forces(unknown)", num, NULL);
         expect(wc_cloth_get_links(wa, c, WC_LINK_BEND, pairs, NULL, 1), WC_ERROR_NOT_FOUND, "get_links(unknown)", num, NULL);
         expect(wc_cloth_get_triangles(wa, c, tri, 1), WC_ERROR_NOT_FOUND, "get_triangles(unknown)", num, NULL);
         expect(wc_cloth_get_view(wa, c, &v), WC_ERROR_NOT_FOUND, "get_view(unknown)", num, NULL);
@@ -593,6 +706,8 @@ int main(void)
     test_grid_def();
     test_mesh_def();
     test_pins();
+    test_soft_pins();
+    test_fields();
     test_arrays();
     test_unknown_cloth();
     test_step_arguments();

@@ -6,7 +6,12 @@
  * crumpled by a random perturbation from a fixed seed so that many bend
  * links are compressed, the two top corners pinned, default material
  * (damping and drag on), 500 steps at half the stable step. A hash
- * (64-bit FNV-1a) of the bytes of all positions and velocities is compared. */
+ * (64-bit FNV-1a) of the bytes of all positions and velocities is compared.
+ *
+ * Then the same with the applied forces on (applied.c): an air velocity
+ * and an external force density that differ from particle to particle,
+ * and one particle in seven soft-pinned with its own stiffness, for each
+ * integrator (Verlet 500 steps, XPBD and the implicit one 40). */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -45,11 +50,33 @@ typedef struct run_result {
     double bend_energy;
 } run_result;
 
-static run_result run(int32_t threads, uint64_t seed)
+/* Wind, a force field and soft pins, all varying over the cloth. */
+static void apply_forces(wc_world *w, int32_t id, int32_t n)
+{
+    double *u = malloc(3 * (size_t)n * sizeof *u), *p = malloc(3 * (size_t)n * sizeof *p);
+    int32_t *idx = malloc((size_t)n * sizeof *idx);
+    double *stiffness = malloc((size_t)n * sizeof *stiffness);
+    int32_t soft = 0;
+    for (int32_t i = 0; i < n; ++i) {
+        u[3 * i] = 1.0 + 0.5 * sin(0.1 * i), u[3 * i + 1] = cos(0.07 * i), u[3 * i + 2] = 0.2;
+        p[3 * i] = 0.3 * cos(0.05 * i), p[3 * i + 1] = -0.2, p[3 * i + 2] = 0.4 * sin(0.03 * i);
+        /* the hard-pinned corners, 4032 and 4095, are multiples of 7 */
+        if (i % 7 == 3) idx[soft] = i, stiffness[soft++] = 20.0 + (i % 13);
+    }
+    CHECK(wc_cloth_set_air_velocity(w, id, u, n) == WC_OK, "air: %s", wc_world_last_error(w));
+    CHECK(wc_cloth_set_external_forces(w, id, p, n) == WC_OK, "forces: %s", wc_world_last_error(w));
+    CHECK(wc_cloth_pin_soft(w, id, idx, stiffness, soft) == WC_OK, "pin_soft: %s",
+          wc_world_last_error(w));
+    free(u), free(p), free(idx), free(stiffness);
+}
+
+static run_result run_with(int32_t threads, uint64_t seed, wc_integrator integrator, int applied,
+                           int steps)
 {
     run_result r = {14695981039346656037ULL, 0, 0.0};
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
+    wd.integrator = integrator;
     wc_world *w = NULL;
     wc_message msg;
     if (wc_world_create(&wd, &w, &msg) != WC_OK) {
@@ -86,8 +113,9 @@ static run_result run(int32_t threads, uint64_t seed)
 
     int32_t pins[2] = {(N_SIDE - 1) * N_SIDE, N_SIDE * N_SIDE - 1};
     CHECK(wc_cloth_pin(w, id, pins, 2) == WC_OK, "pin: %s", wc_world_last_error(w));
+    if (applied) apply_forces(w, id, n);
     const double dt = 0.5 * wc_world_stable_dt(w);
-    for (int s = 0; s < STEPS; ++s)
+    for (int s = 0; s < steps; ++s)
         if (wc_world_step(w, dt) != WC_OK) {
             CHECK(0, "threads %d, step %d: %s", threads, s, wc_world_last_error(w));
             break;
@@ -105,6 +133,30 @@ static run_result run(int32_t threads, uint64_t seed)
     free(v);
     wc_world_destroy(w);
     return r;
+}
+
+static run_result run(int32_t threads, uint64_t seed)
+{
+    return run_with(threads, seed, WC_INTEGRATOR_VERLET, 0, STEPS);
+}
+
+/* The applied forces for one integrator: the same hash for 1, 2 and 4
+ * threads, and not the hash without them. */
+static void applied_forces(wc_integrator integrator, const char *name, int steps, uint64_t seed)
+{
+    run_result plain = run_with(1, seed, integrator, 0, steps);
+    run_result one = run_with(1, seed, integrator, 1, steps);
+    printf("applied forces, %s, %d steps: threads 1: hash %016llx (without them %016llx)", name,
+           steps, (unsigned long long)one.hash, (unsigned long long)plain.hash);
+    CHECK(one.hash != plain.hash, "%s: the applied forces changed nothing", name);
+    int32_t counts[2] = {2, 4};
+    for (int i = 0; i < 2; ++i) {
+        run_result r = run_with(counts[i], seed, integrator, 1, steps);
+        printf(", threads %d: %016llx", counts[i], (unsigned long long)r.hash);
+        CHECK(r.hash == one.hash, "%s, applied forces, threads %d: hash %016llx differs from %016llx",
+              name, counts[i], (unsigned long long)r.hash, (unsigned long long)one.hash);
+    }
+    printf("\n");
 }
 
 int main(void)
@@ -129,5 +181,8 @@ int main(void)
     run_result other = run(1, seed + 1);
     printf("other seed: hash %016llx\n", (unsigned long long)other.hash);
     CHECK(other.hash != one.hash, "hash insensitive to the start");
+    applied_forces(WC_INTEGRATOR_VERLET, "verlet", STEPS, seed);
+    applied_forces(WC_INTEGRATOR_XPBD, "xpbd", 40, seed);
+    applied_forces(WC_INTEGRATOR_IMPLICIT, "implicit", 40, seed);
     return test_report("test_determinism");
 }

@@ -1,6 +1,8 @@
 /* Failure containment (issue 9): every allocation of the library goes
  * through the hook of wc_set_allocator(), and this test makes each one fail
- * in turn, during world creation, while adding cloths, colliders and pins,
+ * in turn, during world creation, while adding cloths, colliders, pins
+ * (hard and soft) and the applied force fields (air velocity, external
+ * forces),
  * and during steps that collide with mesh and convex colliders, self-collide,
  * collide two cloths with each other and stick wet cloth. Each failing call must return WC_ERROR_OUT_OF_MEMORY
  * with a message, free whatever it had allocated (the test tracks every
@@ -186,10 +188,32 @@ static wc_status op(scene *s, int k, const char **what)
         int32_t pins[2] = {0, SIDE - 1};
         return wc_cloth_pin(s->w, s->grid, pins, 2);
     }
+    case 9: {
+        *what = "wc_cloth_pin_soft";
+        int32_t pins[2] = {SIDE * SIDE - SIDE, SIDE * SIDE - 1};
+        double stiffness[2] = {200.0, 300.0};
+        return wc_cloth_pin_soft(s->w, s->grid, pins, stiffness, 2);
+    }
+    case 10: {
+        *what = "wc_cloth_pin (after soft pins: grows their stiffness list)";
+        int32_t pin = SIDE / 2;
+        return wc_cloth_pin(s->w, s->grid, &pin, 1);
+    }
+    case 11: {
+        *what = "wc_cloth_set_air_velocity";
+        double u[3 * SIDE * SIDE];
+        for (int i = 0; i < 3 * SIDE * SIDE; ++i) u[i] = i % 3 == 0 ? 3.0 : 0.1;
+        return wc_cloth_set_air_velocity(s->w, s->grid, u, SIDE * SIDE);
+    }
+    case 12: {
+        *what = "wc_cloth_set_external_forces";
+        double p[3 * 4] = {0.0, 0.5, -1.0, 0.0, 0.5, -1.0, 0.0, 0.5, -1.0, 0.0, 0.5, -1.0};
+        return wc_cloth_set_external_forces(s->w, s->mesh, p, 4);
+    }
     }
     return WC_OK;
 }
-#define OPS 9
+#define OPS 13
 
 /* What a failed call must not change. */
 typedef struct counts {

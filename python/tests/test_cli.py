@@ -194,6 +194,20 @@ BAD = {
                                  ["cloths[0].wetness", "array of 48 numbers", "found an array of 3"]),
     "out of range pin": (with_cloth(pins=[48]), {},
                          ["cloths[0].pins[0]: particle index must be in [0, 48), found 48"]),
+    "wrong air_velocity": (with_cloth(air_velocity=[1, 0]), {},
+                           ["cloths[0].air_velocity: expected 3 numbers (a constant air "
+                            "velocity, m/s) or an array of keyframes"]),
+    "out of range air_velocity": (with_cloth(air_velocity=[0, 0, 2e4]), {},
+                                  ["cloths[0].air_velocity: the air velocity must be at most "
+                                   "10000 m/s long, found [0, 0, 20000]"]),
+    "external_force keyframes out of order": (
+        with_cloth(external_force=[{"time": 1, "value": [0, 0, 1]},
+                                   {"time": 0.5, "value": [0, 0, 2]}]), {},
+        ["cloths[0].external_force[1].time: keyframe times must increase, found 0.5 after 1"]),
+    "pin_stiffness without pins": (with_cloth(pins=[], pin_stiffness=100), {},
+                                   ["cloths[0].pin_stiffness: there are no pins to make soft"]),
+    "out of range pin_stiffness": (with_cloth(pins=[0, 5], pin_stiffness=[100, -1]), {},
+                                   ["cloths[0].pin_stiffness[1]: must be greater than 0, found -1"]),
     "out of range (library)": (with_cloth(material={"density": -0.1}), {},
                                ["cloths[0]: add_grid_cloth: material.density must be in (0, 1000]",
                                 "but is -0.1"]),

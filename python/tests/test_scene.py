@@ -1,5 +1,6 @@
 """Scene files in-process: defaults, every cloth and collider kind, keyframed
-animation, the shipped thesis scenes, OBJ reading and PC2 writing."""
+animation, the applied forces (air_velocity, external_force, pin_stiffness),
+the shipped thesis scenes, OBJ reading and PC2 writing."""
 
 import glob
 import json
@@ -8,7 +9,7 @@ import os
 import numpy as np
 import pytest
 
-from wetcloth import meshio, scene
+from wetcloth import Material, World, meshio, scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENES = sorted(glob.glob(os.path.join(ROOT, "tools", "scenes", "*.json")))
@@ -126,6 +127,112 @@ def test_collider_keyframe_at_time_zero_places_it():
     built.set_targets(0.05)  # held: the hull stays where it is
     np.testing.assert_array_equal(hull.position, [0, 0, 0])
     built.world.close()
+
+
+# ---------------------------------------------------------------------------
+# per-cloth applied forces: air_velocity, external_force, pin_stiffness
+
+
+def grid_cloth(**fields):
+    c = {"grid": {"nu": 4, "nv": 4, "size": [0.5, 0.5]},
+         "material": {"damping": 0, "bend": 0, "stretch": 100, "air_drag": 1.5}}
+    c.update(fields)
+    return c
+
+
+def test_scene_fields_default_to_none():
+    c = from_dict({"cloths": [grid_cloth()]}).cloths[0]
+    assert c["air_velocity"] is None and c["external_force"] is None
+    assert c["pin_stiffness"] is None
+
+
+def test_constant_scene_fields_are_set_when_built():
+    s = from_dict({"gravity": [0, 0, 0], "cloths": [grid_cloth(
+        air_velocity=[2.0, 0.0, 0.0], external_force=[0.0, 0.0, 0.3],
+        pins=[0, 15], pin_stiffness=[40.0, 60.0])]})
+    built = scene.build(s)
+    with built.world as w, World(gravity=(0, 0, 0)) as w2:
+        cloth = built.cloths[0][1]
+        assert cloth.pin_count == 2
+        # the same by hand
+        c2 = w2.add_grid_cloth(4, 4, size=(0.5, 0.5), material=Material(
+            damping=0, bend=0, stretch=100, air_drag=1.5))
+        c2.pin([0, 15], stiffness=[40.0, 60.0])
+        c2.set_air_velocity([2.0, 0.0, 0.0])
+        c2.set_external_forces([0.0, 0.0, 0.3])
+        for f in range(1, 4):
+            built.set_fields((f - 0.5) / 24)
+            built.set_targets(f / 24)
+            w.advance(1 / 24)
+            w2.advance(1 / 24)
+        np.testing.assert_array_equal(cloth.positions, c2.positions)
+        assert cloth.velocities[5, 0] > 0.5  # drifting with the wind
+
+
+def test_keyframed_fields_are_set_at_each_frames_middle():
+    keys = [{"time": 0.0, "value": [0.0, 0.0, 0.0]}, {"time": 1.0, "value": [0.0, 0.0, 2.4]}]
+    s = from_dict({"gravity": [0, 0, 0], "duration": 0.25,
+                   "cloths": [grid_cloth(external_force=keys, air_velocity=[
+                       {"time": 0.5, "value": [1.0, 0.0, 0.0]}])]})
+    field = s.cloths[0]["external_force"]
+    assert isinstance(field, scene.Keyframes)
+    np.testing.assert_array_equal(field.at(0.5), [0, 0, 1.2])
+    built = scene.build(s)
+    with built.world as w, World(gravity=(0, 0, 0)) as w2:
+        cloth = built.cloths[0][1]
+        c2 = w2.add_grid_cloth(4, 4, size=(0.5, 0.5), material=Material(
+            damping=0, bend=0, stretch=100, air_drag=1.5))
+        c2.set_air_velocity([1.0, 0.0, 0.0])  # one keyframe: held
+        for f in range(1, s.frame_count + 1):
+            built.set_fields((f - 0.5) / s.fps)
+            built.set_targets(f / s.fps)
+            w.advance(1 / s.fps)
+            # the frame's middle: on a linear stretch, the frame's mean
+            c2.set_external_forces([0.0, 0.0, 2.4 * (f - 0.5) / s.fps])
+            w2.advance(1 / s.fps)
+        np.testing.assert_array_equal(cloth.positions, c2.positions)
+
+
+def test_scene_run_applies_the_keyframed_fields(tmp_path):
+    keys = [{"time": 0.0, "value": [0.0, 0.0, 0.0]}, {"time": 0.25, "value": [0.0, 0.0, 3.0]}]
+    s = from_dict({"gravity": [0, 0, 0], "duration": 0.25,
+                   "cloths": [grid_cloth(external_force=keys)]})
+    scene.run(s, str(tmp_path / "out"), progress=False, check="none")
+    _, frames = meshio.read_pc2(str(tmp_path / "out" / "cloth.pc2"))
+    rise = frames[:, :, 2].mean(axis=1)
+    # pushed up ever harder: the rise grows faster than linearly
+    assert rise[-1] > rise[0] and np.all(np.diff(rise, 2) > 0)
+
+
+@pytest.mark.parametrize("fields,message", [
+    ({"air_velocity": [1, 2]}, "cloths[0].air_velocity: expected 3 numbers (a constant air "
+                               "velocity, m/s) or an array of keyframes"),
+    ({"air_velocity": "north"}, "cloths[0].air_velocity: expected 3 numbers"),
+    ({"air_velocity": [0, 0, True]}, "cloths[0].air_velocity[2]: expected a number, found a "
+                                     "boolean"),
+    ({"air_velocity": [2e4, 0, 0]}, "cloths[0].air_velocity: the air velocity must be at most "
+                                    "10000 m/s long, found [20000, 0, 0] (20000 m/s)"),
+    ({"external_force": [{"time": 0, "value": [0, 0, 1]}, {"time": 0, "value": [0, 0, 2]}]},
+     "cloths[0].external_force[1].time: keyframe times must increase, found 0 after 0"),
+    ({"external_force": [{"time": 0, "value": [0, 0, 1]}, 5]},
+     "cloths[0].external_force[1]: expected an object, found the number 5"),
+    ({"external_force": [{"time": 0, "translate": [0, 0, 1]}]},
+     "cloths[0].external_force[0].translate: unknown field; expected one of: time, value"),
+    ({"external_force": [{"time": 1, "value": [0, 0, -3e6]}]},
+     "cloths[0].external_force[0].value: the force density must be at most 1e+06 N/m^2 long"),
+    ({"pin_stiffness": 10.0}, "cloths[0].pin_stiffness: there are no pins to make soft"),
+    ({"pins": [0, 1], "pin_stiffness": [10.0]},
+     "cloths[0].pin_stiffness: expected a number or an array of 2 numbers (one per pin), found "
+     "an array of 1"),
+    ({"pins": [0, 1], "pin_stiffness": [10.0, 0.0]},
+     "cloths[0].pin_stiffness[1]: must be greater than 0, found 0"),
+    ({"pins": [0], "pin_stiffness": 2e8}, "cloths[0].pin_stiffness: must be at most 1e+08, found 2e+08"),
+    ({"pins": [0], "pin_stiffness": None}, "cloths[0].pin_stiffness: expected a number, found null"),
+])
+def test_bad_scene_fields_are_named(fields, message):
+    with pytest.raises(scene.SceneError) as e:
+        from_dict({"cloths": [grid_cloth(**fields)]})
+    assert message in str(e.value), str(e.value)
 
 
 @pytest.mark.parametrize("path", SCENES, ids=[os.path.basename(p) for p in SCENES])

@@ -648,29 +648,92 @@ class Cloth:
         return np.frombuffer(ffi.buffer(view.mass, 8 * self.particle_count),
                              dtype=np.float64).copy()
 
-    def pin(self, indices):
-        """Pins particles where they are now (indices not yet pinned)."""
+    def pin(self, indices, stiffness=None):
+        """Pins particles where they are now (indices not yet pinned).
+
+        stiffness None: hard pins, which follow their targets exactly and
+        feel no forces. A number for all, or one per index, 1/s^2 in
+        (0, 1e8]: soft pins, free particles (they feel every force, collide
+        and get wet) pulled toward their targets by springs of stiffness
+        mass * stiffness, so stiffness is the square of a particle's angular
+        frequency about its target: under gravity g it hangs g / stiffness
+        below it and swings with period 2 pi / sqrt(stiffness), at any mesh
+        resolution. Hard and soft pins share one list, in the order pinned:
+        set_pin_targets moves them, pin_count counts them, unpin_all
+        releases them. Soft pins shorten the stable step of "verlet" and
+        "xpbd" (to at most 2 / sqrt(stiffness)); "implicit" solves them
+        implicitly."""
         h = self.world._handle()
         idx = _index_array("indices", indices)
-        self.world._check(lib.wc_cloth_pin(h, self.index, _iptr(idx), idx.shape[0]), "pin")
+        if stiffness is None:
+            self.world._check(lib.wc_cloth_pin(h, self.index, _iptr(idx), idx.shape[0]), "pin")
+            return
+        if np.ndim(stiffness) == 0:
+            s = np.full(idx.shape[0], _float("stiffness", stiffness))
+        else:
+            s = _float_array("stiffness", stiffness, rows=idx.shape[0])
+        self.world._check(lib.wc_cloth_pin_soft(h, self.index, _iptr(idx), _dptr(s),
+                                                idx.shape[0]), "pin")
 
     def unpin_all(self):
+        """Releases every pin, hard and soft."""
         h = self.world._handle()
         self.world._check(lib.wc_cloth_unpin_all(h, self.index), "unpin_all")
 
     @property
     def pin_count(self):
+        """Number of pins, hard and soft."""
         return int(lib.wc_cloth_pin_count(self.world._handle(), self.index))
 
     def set_pin_targets(self, positions):
-        """Where the pins go, (pin_count, 3) m in the order they were pinned;
-        reached at the end of the next step or advance."""
+        """Where the pins go, (pin_count, 3) m in the order they were pinned
+        (hard and soft); reached at the end of the next step or advance."""
         h = self.world._handle()
         t = _float_array("positions", positions, 3, self.pin_count)
         self.world._check(lib.wc_cloth_set_pin_targets(h, self.index, _dptr(t), t.shape[0]),
                           "set_pin_targets")
 
+    def set_air_velocity(self, velocity):
+        """The velocity of the air at each particle, m/s: an (n, 3) array, or
+        one 3-vector for every particle (uniform wind); None for still air
+        again. Held until set again (set it every frame to animate wind).
+        The drag acts on the velocity relative to the air,
+        -Material.air_drag * A * (v - u), so the cloth drifts toward the
+        wind's velocity with the time constant density / air_drag; with
+        air_drag 0 it has no effect. Each vector finite, at most 1e4 m/s."""
+        self._set_field(lib.wc_cloth_set_air_velocity, "velocity", velocity,
+                        "set_air_velocity")
+
+    def set_external_forces(self, force_per_area):
+        """An external force on each particle as a density per rest area,
+        N/m^2: an (n, 3) array, or one 3-vector for every particle; None to
+        clear it. A particle of rest area A feels A * p, so the same field
+        gives the same motion at any mesh resolution (a dry cloth
+        accelerates by p / density). Held until set again; hard-pinned
+        particles ignore it. Each vector finite, at most 1e6 N/m^2."""
+        self._set_field(lib.wc_cloth_set_external_forces, "force_per_area", force_per_area,
+                        "set_external_forces")
+
+    def _set_field(self, fn, name, value, what):
+        h = self.world._handle()
+        if value is None:
+            self.world._check(fn(h, self.index, ffi.NULL, 0), what)
+            return
+        n = self.particle_count
+        try:
+            a = np.ascontiguousarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise _bad("%s: %s must be 3 numbers or an array of shape (%d, 3), found %r"
+                       % (what, name, n, value)) from None
+        if a.shape == (3,):
+            a = np.ascontiguousarray(np.broadcast_to(a, (n, 3)))
+        elif a.shape != (n, 3):
+            raise _bad("%s: %s must be 3 numbers (one vector for every particle) or an array "
+                       "of shape (%d, 3), found shape %s" % (what, name, n, a.shape))
+        self.world._check(fn(h, self.index, _dptr(a), n), "%s: %s" % (what, name))
+
     def stable_dt(self):
+        """Largest stable step of this cloth for the world's integrator, s."""
         return float(lib.wc_cloth_stable_dt(self.world._handle(), self.index))
 
     @property

@@ -178,8 +178,9 @@ MATERIAL_FIELDS = list(_core._MATERIAL_FIELDS)
 SCENE_FIELDS = ["description", "format_version", "duration", "fps", "substeps", "threads",
                 "gravity", "start_frame", "integrator", "implicit_tolerance", "cloths",
                 "colliders"]
-CLOTH_FIELDS = ["name", "grid", "obj", "material", "wetness", "pins", "pin_keyframes",
-                "self_collision", "collide_with_cloths"]
+CLOTH_FIELDS = ["name", "grid", "obj", "material", "wetness", "pins", "pin_stiffness",
+                "pin_keyframes", "air_velocity", "external_force", "self_collision",
+                "collide_with_cloths"]
 GRID_FIELDS = ["nu", "nv", "size", "center", "axis_u", "axis_v"]
 COLLIDER_TYPES = ["mesh", "sphere", "box", "capsule", "convex"]
 COLLIDER_FIELDS = {
@@ -192,11 +193,21 @@ COLLIDER_FIELDS = {
 COMMON_COLLIDER_FIELDS = ["type", "name", "thickness", "friction", "keyframes"]
 KEYFRAME_FIELDS = ["time", "translate"]
 NAME_PATTERN = r"[A-Za-z0-9_\-]+"
+# the library's limits (wc_cloth_pin_soft, wc_cloth_set_air_velocity,
+# wc_cloth_set_external_forces), checked here so that the message names the
+# scene's field
+MAX_PIN_STIFFNESS = 1e8
+# per-cloth fields given as a vector or keyframes: (largest length, unit,
+# what the value is)
+VECTOR_FIELDS = {
+    "air_velocity": (1e4, "m/s", "air velocity"),
+    "external_force": (1e6, "N/m^2", "force density"),
+}
 
 
 class Keyframes:
-    """Piecewise-linear translation over time, held before the first and
-    after the last keyframe."""
+    """A piecewise-linear vector over time (a translation, or a field's
+    value), held before the first and after the last keyframe."""
 
     def __init__(self, times, offsets):
         self.times = np.array(times, dtype=np.float64)
@@ -208,17 +219,64 @@ class Keyframes:
         return np.array([np.interp(t, self.times, self.offsets[:, k]) for k in range(3)])
 
 
-def _keyframes(reader, key):
+def _keyframes(reader, key, value_key="translate", check=None):
+    """Keyframes {"time", value_key}; check(fail, key, vector) checks each
+    value."""
     items = reader.array(key, [])
     times, offsets = [], []
     for i, item in enumerate(items):
-        k = _Reader(reader.source, "%s[%d]" % (reader.where(key), i), item, KEYFRAME_FIELDS)
+        k = _Reader(reader.source, "%s[%d]" % (reader.where(key), i), item,
+                    ["time", value_key])
         t = k.number("time", minimum=0.0)
         if times and t <= times[-1]:
             k.fail("time", "keyframe times must increase, found %g after %g" % (t, times[-1]))
         times.append(t)
-        offsets.append(k.vector("translate", 3))
+        offsets.append(k.vector(value_key, 3))
+        if check is not None:
+            check(k.fail, value_key, offsets[-1])
     return Keyframes(times, offsets)
+
+
+def _vector_field(reader, key):
+    """A per-cloth field (VECTOR_FIELDS): None when absent, a constant
+    3-vector, or Keyframes of {"time", "value"} (values between keyframes
+    are convex combinations of theirs, so checking the keyframes' lengths
+    checks every value)."""
+    if not reader.has(key):
+        return None
+    limit, unit, what = VECTOR_FIELDS[key]
+
+    def check(fail, where, v):
+        length = math.sqrt(sum(x * x for x in v))
+        if not length <= limit:
+            fail(where, "the %s must be at most %g %s long, found [%s] (%g %s)" %
+                 (what, limit, unit, ", ".join("%g" % x for x in v), length, unit))
+
+    v = reader.raw(key)
+    if isinstance(v, list) and any(isinstance(x, dict) for x in v):
+        return _keyframes(reader, key, "value", check)
+    if not isinstance(v, list) or len(v) != 3:
+        reader.fail(key, "expected 3 numbers (a constant %s, %s) or an array of keyframes "
+                    "{\"time\": s, \"value\": [x, y, z]}, found %s" % (what, unit, _type_name(v)))
+    vector = reader.vector(key, 3)
+    check(reader.fail, key, vector)
+    return vector
+
+
+def _pin_stiffness(reader, pins):
+    """None (hard pins), one stiffness for every pin, or one per pin."""
+    if not reader.has("pin_stiffness"):
+        return None
+    v = reader.raw("pin_stiffness")
+    if not pins:
+        reader.fail("pin_stiffness", "there are no pins to make soft")
+    if isinstance(v, list):
+        if len(v) != len(pins):
+            reader.fail("pin_stiffness", "expected a number or an array of %d numbers (one per "
+                        "pin), found an array of %d" % (len(pins), len(v)))
+        return [check_number(reader.fail, "pin_stiffness[%d]" % i, x, maximum=MAX_PIN_STIFFNESS,
+                             above=0.0) for i, x in enumerate(v)]
+    return check_number(reader.fail, "pin_stiffness", v, maximum=MAX_PIN_STIFFNESS, above=0.0)
 
 
 class Scene:
@@ -343,9 +401,12 @@ def _cloth(scene, path, item, index):
             r.fail("pins[%d]" % i, "particle index must be in [0, %d), found %d" %
                    (c["particle_count"], p))
     c["pins"] = pins
+    c["pin_stiffness"] = _pin_stiffness(r, pins)
     c["pin_keyframes"] = _keyframes(r, "pin_keyframes")
     if c["pin_keyframes"].times.size and not pins:
         r.fail("pin_keyframes", "there are no pins to move")
+    for key in VECTOR_FIELDS:
+        c[key] = _vector_field(r, key)
     c["self_collision"] = r.boolean("self_collision", False)
     c["collide_with_cloths"] = r.boolean("collide_with_cloths", True)
     return c
@@ -425,6 +486,17 @@ class Built:
         self.cloths = []      # (spec, Cloth, pin start positions)
         self.colliders = []   # (spec, collider, rest geometry)
 
+    def set_fields(self, t):
+        """The keyframed air velocity and external force density at time t,
+        held until set again (the run sets them at the middle of each
+        frame: on a linear stretch of keyframes, the frame's mean). Constant
+        ones were set when the world was built."""
+        for spec, cloth, _ in self.cloths:
+            for key, setter in (("air_velocity", cloth.set_air_velocity),
+                                ("external_force", cloth.set_external_forces)):
+                if isinstance(spec[key], Keyframes):
+                    setter(spec[key].at(t))
+
     def set_targets(self, t):
         """Pin and collider targets for time t (the end of the next frame)."""
         for spec, cloth, start in self.cloths:
@@ -470,8 +542,14 @@ def build(scene, threads=None):
                                 collide_with_cloths=c["collide_with_cloths"])
             start = np.zeros((0, 3))
             if c["pins"]:
-                guarded(c["path"] + ".pins", cloth.pin, c["pins"])
+                guarded(c["path"] + ".pins", cloth.pin, c["pins"], stiffness=c["pin_stiffness"])
                 start = cloth.positions[c["pins"]]
+            for key, setter in (("air_velocity", cloth.set_air_velocity),
+                                ("external_force", cloth.set_external_forces)):
+                field = c[key]
+                if field is not None:
+                    value = field.at(0.0) if isinstance(field, Keyframes) else field
+                    guarded("%s.%s" % (c["path"], key), setter, value)
             b.cloths.append((c, cloth, start))
         for c in scene.colliders:
             k = c["type"]
@@ -551,6 +629,7 @@ def run(scene, out_dir, progress=True, check="every", threads=None, frames=None,
             for f in range(1, frame_count + 1):
                 t0 = time.perf_counter()
                 try:
+                    built.set_fields((f - 0.5) * frame_dt)
                     built.set_targets(f * frame_dt)
                     used = world.advance(frame_dt, scene.substeps)
                 except WetclothError as e:

@@ -437,6 +437,18 @@ static void op_cloth_arrays(reader *r, wc_world *w)
         if (u8(r) == 7) g_buf[i] = num(r, usual);
     }
     const double *arr = u8(r) == 1 ? NULL : g_buf;
+    /* the applied force fields, from values no older input used much (so
+     * the corpus keeps its meaning); NULL with count 0 clears them */
+    if (what >= 250) {
+        int clear = u8(r) == 1;
+        if (what < 253)
+            check(w, wc_cloth_set_air_velocity(w, cloth, clear ? NULL : arr, clear ? 0 : given),
+                  "wc_cloth_set_air_velocity");
+        else
+            check(w, wc_cloth_set_external_forces(w, cloth, clear ? NULL : arr, clear ? 0 : given),
+                  "wc_cloth_set_external_forces");
+        return;
+    }
     switch (what % 5) {
     case 0: check(w, wc_cloth_set_positions(w, cloth, arr, given), "wc_cloth_set_positions"); break;
     case 1: check(w, wc_cloth_set_velocities(w, cloth, arr, given), "wc_cloth_set_velocities"); break;
@@ -464,7 +476,13 @@ static void op_pin(reader *r, wc_world *w)
     if (how == 1) check(w, wc_cloth_unpin_all(w, cloth), "wc_cloth_unpin_all");
     else if (how == 2) check(w, wc_cloth_pin(w, cloth, NULL, m), "wc_cloth_pin");
     else if (how == 3) check(w, wc_cloth_pin(w, cloth, idx, -1), "wc_cloth_pin");
-    else check(w, wc_cloth_pin(w, cloth, idx, m), "wc_cloth_pin");
+    else if (how == 4 || how == 5) {
+        /* soft pins, each stiffness from the bytes (NaN, 0, huge, ...) */
+        double stiffness[8];
+        for (int32_t k = 0; k < m; ++k) stiffness[k] = num(r, 50.0);
+        check(w, wc_cloth_pin_soft(w, cloth, idx, how == 5 && m ? NULL : stiffness, m),
+              "wc_cloth_pin_soft");
+    } else check(w, wc_cloth_pin(w, cloth, idx, m), "wc_cloth_pin");
 }
 
 static void op_move_collider(reader *r, wc_world *w)
