@@ -10,14 +10,16 @@ it too. Playing the animation changes nothing and sets nothing.
 
 The add-on's own changes to an object (a bake hooking up its modifiers)
 run inside suppressed() and flush the depsgraph before leaving it, so they
-never mark anything.
+never mark anything. The same handler keeps the wetness modifiers with the
+Wet Cloth modifier when the artist hides, moves or removes it
+(stack.sync).
 """
 
 import contextlib
 
 import bpy
 
-from . import cache
+from . import cache, stack
 
 _suppress = 0
 
@@ -47,6 +49,9 @@ def on_depsgraph_update(_scene, depsgraph):
         if isinstance(ob, bpy.types.Object) and (update.is_updated_transform or
                                                  update.is_updated_geometry):
             changed.add(ob.name)
+            if ob.type == "MESH" and ob.library is None and update.is_updated_geometry:
+                with suppressed():
+                    stack.sync(ob)  # the artist hid, moved or removed Wet Cloth
     if not changed:
         return
     for cloth in _baked_cloths():

@@ -150,12 +150,12 @@ def _move_before(ob, name, anchor):
 
 def hook_up(ob, positions_file, wetness_file, start_frame):
     """Points the modifiers at a new bake's files (paths as Blender should
-    keep them: "//" relative where the file is saved)."""
+    keep them: "//" relative where the file is saved). The Wet Cloth
+    modifier keeps the visibility the artist gave it."""
     cloth = ensure_cloth_modifier(ob)
     _setup_mesh_cache(cloth)
     cloth.filepath = positions_file
     cloth.frame_start = float(start_frame)
-    cloth.show_viewport = cloth.show_render = True
 
     wet = ob.modifiers.get(WETNESS)
     if wet is None or wet.type != "MESH_CACHE":
@@ -165,7 +165,6 @@ def hook_up(ob, positions_file, wetness_file, start_frame):
     _setup_mesh_cache(wet)
     wet.filepath = wetness_file
     wet.frame_start = float(start_frame)
-    wet.show_viewport = wet.show_render = True
     wet.show_expanded = False
 
     attrs = ob.modifiers.get(ATTRIBUTES)
@@ -174,11 +173,39 @@ def hook_up(ob, positions_file, wetness_file, start_frame):
             ob.modifiers.remove(attrs)
         attrs = ob.modifiers.new(ATTRIBUTES, "NODES")
     attrs.node_group = attributes_node_group()
-    attrs.show_viewport = attrs.show_render = True
     attrs.show_expanded = False
+    sync(ob)
 
-    _move_before(ob, WETNESS, POSITIONS)
-    _move_before(ob, ATTRIBUTES, POSITIONS)
+
+def sync(ob):
+    """Keeps the wetness modifiers with the Wet Cloth modifier: right above
+    it, shown when it is shown (alone they would leave the mesh's positions
+    at the wetness values), and gone when it is gone (the files stay).
+    Returns whether anything changed."""
+    cloth = cloth_modifier(ob)
+    ours = [ob.modifiers.get(n) for n in (WETNESS, ATTRIBUTES)]
+    changed = False
+    if cloth is None:
+        for m in ours:
+            if m is not None:
+                ob.modifiers.remove(m)
+                changed = True
+        return changed
+    for m in ours:
+        if m is None:
+            continue
+        for attr in ("show_viewport", "show_render"):
+            if getattr(m, attr) != getattr(cloth, attr):
+                setattr(m, attr, getattr(cloth, attr))
+                changed = True
+    names = [m.name for m in ob.modifiers]
+    want = [m.name for m in ours if m is not None] + [POSITIONS]
+    at = names.index(POSITIONS) - len(want) + 1
+    if names[at:at + len(want)] != want:
+        for name in want[:-1]:
+            _move_before(ob, name, POSITIONS)
+        changed = True
+    return changed
 
 
 def referenced_files(ob):

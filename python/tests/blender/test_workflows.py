@@ -275,12 +275,38 @@ def test_subdivision_above_and_solidify_below(project):
     played = evaluated_positions(cloth)
     assert len(played) == 2 * n  # Solidify doubled the baked sheet
     np.testing.assert_allclose(played[:n], frames[11], atol=2e-3)
-    # hiding Wet Cloth and showing it again changes nothing about the bake
+    # hiding Wet Cloth hides its wetness modifiers with it (alone they would
+    # put the mesh at the wetness values); a bake keeps it hidden; showing
+    # it again plays the bake
+    layer = bpy.context.view_layer
     cloth.modifiers["Wet Cloth"].show_viewport = False
+    layer.update()
+    assert not cloth.modifiers["Wet Cloth Wetness"].show_viewport
+    assert len(evaluated_positions(cloth)) == 2 * n  # the subdivided mesh, thickened
     assert bake(cloth) == {"FINISHED"}
     assert cloth.modifiers["Wet Cloth"].show_viewport is False
-    cloth.modifiers["Wet Cloth"].show_viewport = True
     assert read_pc2(cache_path(cloth))[0]["n"] == n
+    cloth.modifiers["Wet Cloth"].show_viewport = True
+    layer.update()
+    assert cloth.modifiers["Wet Cloth Wetness"].show_viewport
+    _header, frames = read_pc2(cache_path(cloth))
+    np.testing.assert_allclose(evaluated_positions(cloth)[:n], frames[11], atol=2e-3)
+    # moving Wet Cloth to the end takes the wetness modifiers along
+    cloth.modifiers.move(cloth.modifiers.find("Wet Cloth"), len(cloth.modifiers) - 1)
+    layer.update()
+    assert [m.name for m in cloth.modifiers] == ["Subdivision", "Solidify",
+                                                  "Wet Cloth Wetness", "Wet Cloth Attributes",
+                                                  "Wet Cloth"]
+    cloth.modifiers.move(len(cloth.modifiers) - 1, 1)
+    layer.update()
+    assert [m.name for m in cloth.modifiers][-1] == "Solidify"
+    # removing Wet Cloth removes them (the files stay for Free Bake)
+    copy = cloth.copy()
+    bpy.context.scene.collection.objects.link(copy)
+    copy.modifiers.remove(copy.modifiers["Wet Cloth"])
+    layer.update()
+    assert [m.name for m in copy.modifiers] == ["Subdivision", "Solidify"]
+    bpy.data.objects.remove(copy)
     # the modifiers above changing the vertex count during the bake are an error
     sub.keyframe_insert("levels", frame=1)
     sub.levels = 2
