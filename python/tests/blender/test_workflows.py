@@ -619,3 +619,46 @@ def test_soft_pins_from_the_groups_weights(project):
     # a stiffness out of range is refused, not clamped
     s.pin_stiffness = 0.0
     assert "Pin Stiffness is 0 but must be above 0" in bake_error(cloth)
+
+
+_FARM = """
+import os, sys, tempfile
+os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp()  # no add-on at all
+import bpy
+import numpy as np
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+assert not hasattr(bpy.types.Object, "wet_cloth")
+ob = bpy.data.objects["Cloth"]
+bpy.context.scene.frame_set(int(sys.argv[2]))
+ev = ob.evaluated_get(bpy.context.evaluated_depsgraph_get())
+m = ev.to_mesh()
+co = np.empty(3 * len(m.vertices), np.float32)
+m.vertices.foreach_get("co", co)
+stuck = np.empty(len(m.vertices), np.float32)
+m.attributes["wet_cloth_stuck"].data.foreach_get("value", stuck)
+np.save(sys.argv[3], np.concatenate([co, stuck]))
+ev.to_mesh_clear()
+sys.stdout.flush()
+os._exit(0)
+"""
+
+
+def test_a_machine_without_the_add_on_plays_the_bake(project, tmp_path):
+    """A render farm has the .blend and the cache files, not the add-on:
+    Blender alone plays the positions and the per-frame attributes."""
+    cloth = small_scene()
+    assert bake(cloth) == {"FINISHED"}
+    save_as(bpy.data.filepath)
+    _header, frames = read_pc2(cache_path(cloth))
+    _header, state = read_pc2(wetness_path(cloth))
+    script = tmp_path / "farm.py"
+    script.write_text(_FARM)
+    out = tmp_path / "farm.npy"
+    r = subprocess.run([sys.executable, str(script), bpy.data.filepath, "24", str(out)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and out.exists(), r.stdout + r.stderr
+    got = np.load(out)
+    n = frames.shape[1]
+    np.testing.assert_allclose(got[:3 * n].reshape(n, 3), frames[23], atol=1e-6)
+    np.testing.assert_array_equal(got[3 * n:], state[23, :, 1])
+    assert got[3 * n:].sum() > 0
