@@ -9,7 +9,8 @@ renders one still with Cycles on the CPU.
 Runs inside bpy (scripts/venv-blender.sh makes .venv-blender/). The add-on
 zip is built with tools/build_blender_addon.py by the Python of .venv/ (it
 needs cffi) and installed into a temporary Blender user folder, as a user
-would install it. Writes OUT/wet_cloth_demo.blend, OUT/cache/*.pc2 and the
+would install it. Writes OUT/wet_cloth_demo.blend, its bakes in
+OUT/wetcloth_wet_cloth_demo/ and the
 image.
 """
 
