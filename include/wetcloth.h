@@ -112,8 +112,9 @@ typedef enum wc_integrator {
 typedef struct wc_world_def {
     /// Gravitational acceleration, m/s^2, finite. Default (0, 0, -9.81).
     double gravity[3];
-    /// OpenMP threads used inside a step. 0 = OpenMP's default; 1 .. 1024.
-    /// Ignored when the library was built without OpenMP.
+    /// OpenMP threads used inside a step, at most. 0 = OpenMP's default
+    /// (the machine's cores); 1 .. 1024. Ignored when the library was built
+    /// without OpenMP. See adapt_threads.
     int32_t thread_count;
     /// Integrator. Default WC_INTEGRATOR_VERLET.
     wc_integrator integrator;
@@ -136,6 +137,14 @@ typedef struct wc_world_def {
     /// inextensible cloth gained energy (1 is half that; docs/model.md has
     /// the figures).
     double implicit_tolerance;
+    /// 1 (default): the world times its steps and runs them on fewer than
+    /// thread_count threads whenever that is faster: when other programs
+    /// keep cores busy (a thread the scheduler takes away holds up every
+    /// barrier of the step), or when a cloth is too small to share. It
+    /// probes a neighbouring count now and then and keeps the faster. The
+    /// results are the same bits for any thread count, so this changes only
+    /// the time. 0: always thread_count threads (for measuring scaling).
+    int32_t adapt_threads;
 } wc_world_def;
 
 /// The default world description.
@@ -678,6 +687,8 @@ typedef struct wc_step_stats {
     /// conjugate gradients), summed over the cloths and, for
     /// wc_world_advance, over its substeps. 0 for Verlet and XPBD.
     int64_t solver_iterations;
+    /// Threads the last step ran on (see wc_world_def.adapt_threads).
+    int32_t threads;
 } wc_step_stats;
 
 /// Statistics of the last step.

@@ -62,6 +62,7 @@ wc_world_def wc_world_def_default(void)
     d.substep_safety = 0.9;
     d.max_substeps = 100000;
     d.implicit_tolerance = 1.0;
+    d.adapt_threads = 1;
     return d;
 }
 
@@ -92,6 +93,9 @@ static wc_status validate_world_def(const wc_world_def *d, wc_message *msg)
         return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.implicit_tolerance must be in [0, 1000] m/s^2 but is %g",
                        d->implicit_tolerance);
+    if (d->adapt_threads != 0 && d->adapt_threads != 1)
+        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                       "world_def.adapt_threads must be 0 or 1 but is %d", (int)d->adapt_threads);
     return WC_OK;
 }
 
@@ -108,6 +112,7 @@ wc_status wc_world_create(const wc_world_def *def, wc_world **out_world, wc_mess
     wc_world *w = wc_alloc_array(1, sizeof *w);
     if (!w) return wc_fail(out_message, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a world");
     w->def = *def;
+    wc_thread_tuner_create(&w->tuner, wc_thread_count(def->thread_count), def->adapt_threads);
     *out_world = w;
     return WC_OK;
 }
@@ -292,8 +297,9 @@ static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_f
 static wc_status world_step(wc_world *w, double dt, double share, double pin_start,
                             double pin_fraction)
 {
-    int threads = wc_thread_count(w->def.thread_count);
+    int threads = wc_thread_tuner_threads(&w->tuner);
     memset(&w->stats, 0, sizeof w->stats);
+    w->stats.threads = threads;
     double *phase = w->phase_seconds, t0 = wc_clock_seconds(), t1;
     /* soft pins pull toward where their targets are when the integrator
      * evaluates forces: the step's start, or its end for backward Euler */
@@ -346,6 +352,17 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_sta
     phase[3] += wc_clock_seconds() - t0;
     w->time += dt;
     return WC_OK;
+}
+
+/* A step, timed for the thread tuner: the next step's thread count comes
+ * from how long this one took on its count. */
+static wc_status timed_step(wc_world *w, double dt, double share, double pin_start,
+                            double pin_fraction)
+{
+    double start = wc_clock_seconds();
+    wc_status s = world_step(w, dt, share, pin_start, pin_fraction);
+    wc_thread_tuner_record(&w->tuner, wc_clock_seconds() - start);
+    return s;
 }
 
 /* Before a step or an advance: no phase time yet. */
@@ -405,7 +422,7 @@ wc_status wc_world_step(wc_world *w, double dt)
     wc_status s = check_step_length(w, "wc_world_step: dt", dt);
     if (s) return s;
     start_timing(w);
-    s = world_step(w, dt, 1.0, 0.0, 1.0);
+    s = timed_step(w, dt, 1.0, 0.0, 1.0);
     finish_timing(w);
     settle_pins(w, s ? 0.0 : 1.0);
     return s;
@@ -442,7 +459,7 @@ wc_status wc_world_advance(wc_world *w, double frame_dt, int32_t substeps)
     start_timing(w);
     int32_t done = 0; /* substeps that succeeded */
     while (done < substeps) {
-        s = world_step(w, dt, 1.0 / (substeps - done), (double)done / substeps,
+        s = timed_step(w, dt, 1.0 / (substeps - done), (double)done / substeps,
                        (double)(done + 1) / substeps);
         if (s) break;
         ++done;

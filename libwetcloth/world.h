@@ -4,6 +4,7 @@
 #include "cloth.h"
 #include "collider.h"
 #include "contact_backup.h"
+#include "thread_tuner.h"
 #include "wetcloth.h"
 
 struct wc_world {
@@ -32,6 +33,8 @@ struct wc_world {
     /// The cloths that collide with each other (cloth_group.h); NULL while
     /// fewer than two do.
     struct wc_cloth_group *group;
+    /// How many threads the next step runs on (thread_tuner.h).
+    wc_thread_tuner tuner;
 };
 
 /// The world's message buffer, writable from const entry points.

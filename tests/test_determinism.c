@@ -76,6 +76,7 @@ static run_result run_with(int32_t threads, uint64_t seed, wc_integrator integra
     run_result r = {14695981039346656037ULL, 0, 0.0};
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
+    wd.adapt_threads = 0; /* exactly this many (test_thread_tuner: changing counts) */
     wd.integrator = integrator;
     wc_world *w = NULL;
     wc_message msg;

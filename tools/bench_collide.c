@@ -46,6 +46,7 @@ static result run_from(int size, int self_collision, int threads, double seconds
 {
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
+    wd.adapt_threads = 0; /* measured at exactly this count */
     wc_world *w;
     wc_message m;
     bench_check(wc_world_create(&wd, &w, &m), NULL, m.text);

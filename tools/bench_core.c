@@ -30,6 +30,7 @@ static double run(int size, int steps, int threads, double *stable_dt, int32_t *
 {
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
+    wd.adapt_threads = 0; /* measured at exactly this count */
     wc_world *w;
     wc_message m;
     bench_check(wc_world_create(&wd, &w, &m), NULL, m.text);

@@ -3,7 +3,10 @@
  *
  *   build/tools/bench_integrators [options]
  *     seconds=0.5        simulated time (frames of 1/24 s)
- *     threads=1          OpenMP threads
+ *     threads=1          OpenMP threads (at most, with adapt=1)
+ *     adapt=1            the world's adapt_threads (the library's default): a
+ *                        step may run on fewer threads when measured faster;
+ *                        0 runs exactly `threads`
  *     sizes=20,101       n of the n x n grid cloths (101^2 = 10,201 particles,
  *                        the size of Blender's figures in NOTES)
  *     self=0,1           self-collision off, on
@@ -54,7 +57,7 @@
 
 typedef struct options {
     double seconds, target, tolerance;
-    int threads, stop, reference;
+    int threads, adapt, stop, reference;
     int sizes[MAX_LIST], size_count;
     int selfs[MAX_LIST], self_count;
     int integrators[MAX_LIST], integrator_count;
@@ -74,11 +77,12 @@ typedef struct run_result {
 
 static const char *const NAMES[3] = {"verlet", "xpbd", "implicit"};
 
-static wc_world *make_world(int size, int self, int integrator, int threads, double tolerance,
-                            int32_t *cloth)
+static wc_world *make_world(int size, int self, int integrator, int threads, int adapt,
+                            double tolerance, int32_t *cloth)
 {
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
+    wd.adapt_threads = adapt;
     wd.implicit_tolerance = tolerance;
     wd.integrator = (wc_integrator)integrator;
     wd.max_substeps = 10000000;
@@ -111,7 +115,7 @@ static run_result run(const options *o, int size, int self, int integrator, int 
                       double tolerance)
 {
     int32_t cl;
-    wc_world *w = make_world(size, self, integrator, o->threads, tolerance, &cl);
+    wc_world *w = make_world(size, self, integrator, o->threads, o->adapt, tolerance, &cl);
     run_result r;
     memset(&r, 0, sizeof r);
     r.frames = (int)lround(o->seconds * 24);
@@ -268,7 +272,7 @@ static options parse(int argc, char **argv)
 {
     options o;
     memset(&o, 0, sizeof o);
-    o.seconds = 0.5, o.threads = 1, o.target = 0.01, o.stop = 1, o.reference = 1;
+    o.seconds = 0.5, o.threads = 1, o.target = 0.01, o.stop = 1, o.reference = 1, o.adapt = 1;
     o.tolerance = wc_world_def_default().implicit_tolerance;
     o.size_count = parse_list("sizes", "20,101", o.sizes, 0);
     o.self_count = parse_list("self", "0,1", o.selfs, 0);
@@ -285,6 +289,7 @@ static options parse(int argc, char **argv)
         const char *v = eq + 1;
         if (!strcmp(key, "seconds")) o.seconds = number(key, v);
         else if (!strcmp(key, "threads")) o.threads = integer(key, v);
+        else if (!strcmp(key, "adapt")) o.adapt = integer(key, v);
         else if (!strcmp(key, "target")) o.target = number(key, v);
         else if (!strcmp(key, "stop")) o.stop = integer(key, v);
         else if (!strcmp(key, "reference")) o.reference = integer(key, v);
@@ -304,14 +309,15 @@ static options parse(int argc, char **argv)
 int main(int argc, char **argv)
 {
     options o = parse(argc, argv);
-    printf("thesis drape, %.2f s simulated (%d frames of 1/24 s), %d thread(s), implicit "
+    printf("thesis drape, %.2f s simulated (%d frames of 1/24 s), %d thread(s)%s, implicit "
            "tolerance %g m/s^2. error: RMS "
            "distance over particles and frames to the same integrator at 8x the substeps (solved "
            "to round-off), / 1 m; "
            "vs verlet: the same against Verlet at its automatic step. ms per simulated frame, "
            "its CPU time (cpu ms, all threads), the phases forces / integration / collisions (wall). x blender: Blender's ms per frame "
            "(NOTES) / ours. cg/step: the implicit integrator's conjugate-gradient iterations per substep.\n\n",
-           o.seconds, (int)lround(o.seconds * 24), o.threads, o.tolerance);
+           o.seconds, (int)lround(o.seconds * 24), o.threads,
+           o.adapt ? " at most (adapt=1)" : " exactly (adapt=0)", o.tolerance);
     printf("%-9s %-4s %-9s %8s %10s %8s %7s %7s %7s %10s %10s %9s %8s\n", "particles", "self",
            "integr.", "steps/fr", "ms/frame", "cpu ms", "force", "integr", "collide", "error", "vs verlet",
            "x blender", "cg/step");

@@ -63,6 +63,7 @@ wc_world *bench_resting_world(int size, int self_collision, int threads, double 
 {
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
+    wd.adapt_threads = 0; /* measured at exactly this count */
     wc_world *w;
     wc_message m;
     bench_check(wc_world_create(&wd, &w, &m), NULL, m.text);

@@ -47,6 +47,7 @@ static wc_world *scene(int size, int config, int threads, int32_t *cloth)
 {
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = threads;
+    wd.adapt_threads = 0; /* measured at exactly this count */
     wc_world *w = NULL;
     wc_message msg;
     if (wc_world_create(&wd, &w, &msg) != WC_OK) {

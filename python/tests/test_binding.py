@@ -449,9 +449,26 @@ def test_stats_keys():
         s = w.stats
         assert set(s) == {"steps", "time", "last_substeps", "collider_contacts",
                           "cloth_contacts", "failsafe_particles", "stuck_particles",
-                          "step_seconds", "phase_seconds", "solver_iterations"}
+                          "step_seconds", "phase_seconds", "solver_iterations", "threads"}
         assert s["steps"] == s["last_substeps"] > 0 and s["step_seconds"] > 0
         assert s["solver_iterations"] == 0  # Verlet solves no linear system
+        assert s["threads"] >= 1
+
+
+def test_adapt_threads():
+    """adapt_threads=False runs exactly `threads`; True (the default) may
+    run fewer, with the same bits (test_thread_tuner checks the choice)."""
+    out = []
+    for adapt in (False, True):
+        with World(threads=2, adapt_threads=adapt) as w:
+            c = w.add_grid_cloth(70, 70)
+            for _ in range(8):
+                w.advance(1 / 240, substeps=1)
+                assert w.stats["threads"] in ((2,) if not adapt else (1, 2))
+            out.append(c.positions.tobytes())
+    assert out[0] == out[1]
+    with pytest.raises(WetclothError, match="adapt_threads must be True or False"):
+        World(adapt_threads=2)
 
 
 def test_solver_iterations_of_the_implicit_integrator():

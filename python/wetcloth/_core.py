@@ -195,7 +195,11 @@ class World:
     """A simulation world: cloths, colliders, stepping.
 
     gravity        m/s^2, (x, y, z)
-    threads        OpenMP threads inside a step, 0 = OpenMP's default
+    threads        OpenMP threads inside a step at most, 0 = OpenMP's default
+    adapt_threads  True (default): each step may run on fewer threads when
+                   the world measures that to be faster (a busy machine, a
+                   small cloth); the results are the same bits either way.
+                   False: always `threads`
     substep_safety fraction of the stable step advance() uses, (0, 1]
     max_substeps   most substeps advance() may choose, 1 .. 10^7
     integrator     "verlet" (default, explicit), "xpbd" (strain-limited
@@ -219,7 +223,8 @@ class World:
     DEFAULT_IMPLICIT_TOLERANCE = None
 
     def __init__(self, gravity=(0.0, 0.0, -9.81), threads=0, substep_safety=0.9,
-                 max_substeps=100000, integrator="verlet", implicit_tolerance=None):
+                 max_substeps=100000, integrator="verlet", implicit_tolerance=None,
+                 adapt_threads=True):
         if not isinstance(integrator, str) or integrator not in World.INTEGRATORS:
             raise _bad("integrator must be one of %s but is %r"
                        % (", ".join(repr(k) for k in World.INTEGRATORS), integrator))
@@ -227,6 +232,9 @@ class World:
         d.integrator = getattr(lib, World.INTEGRATORS[integrator])
         d.gravity = list(_vector("gravity", gravity, 3))
         d.thread_count = _int32("threads", threads)
+        if not isinstance(adapt_threads, (bool, np.bool_)):
+            raise _bad("adapt_threads must be True or False but is %r" % (adapt_threads,))
+        d.adapt_threads = int(bool(adapt_threads))
         d.substep_safety = _float("substep_safety", substep_safety)
         d.max_substeps = _int32("max_substeps", max_substeps)
         if implicit_tolerance is not None:
@@ -498,7 +506,8 @@ class World:
         library's wall time by phase (forces, integrate, collide, wet) of the
         last step(), or of all substeps of the last advance(); and
         solver_iterations, the implicit integrator's conjugate-gradient
-        iterations over the same steps (0 for the other integrators)."""
+        iterations over the same steps (0 for the other integrators); threads,
+        the threads the last step ran on."""
         h = self._handle()
         s = lib.wc_world_get_stats(h)
         return {
@@ -517,6 +526,7 @@ class World:
                 "wet": float(s.wet_seconds),
             },
             "solver_iterations": int(s.solver_iterations),
+            "threads": int(s.threads),
         }
 
 

@@ -1,0 +1,140 @@
+#include "thread_tuner.h"
+
+/* A world starts on one thread and first tries more after FIRST_PERIOD
+ * steps: on a busy machine a step on more threads can take many times
+ * longer (15x was measured here, at 4 runnable processes on 2 cores), and
+ * a start on one costs an idle machine only those first steps at its
+ * single-thread speed. Probes then come every FIRST_PERIOD steps, backing
+ * off to BACKOFF_PERIOD while the chosen count keeps winning (so a machine
+ * that becomes free again is used within that many steps), and never more
+ * often than keeps a lost probe's cost (its 4 steps on the slower count)
+ * to about PROBE_COST of the steps between probes, up to MAX_PERIOD. */
+#define FIRST_PERIOD 32
+#define BACKOFF_PERIOD 1024
+#define MAX_PERIOD 4096
+#define PROBE_COST 0.05
+/* A chosen count of several threads whose steps take this much longer
+ * than when it was last compared is probed against fewer at once (the
+ * machine got busier). A single thread that gets slower is left alone:
+ * more threads would only be slower still. */
+#define SLOWDOWN 1.5
+/* More threads must be this much faster to be taken (they cost the rest of
+ * the machine more); fewer are taken when they are no slower. */
+#define MORE_THREADS_GAIN 0.97
+
+/* A probe runs the chosen count (A) and the probed one (B) in the order
+ * A B B A, twice: within each block both get the same sum of step
+ * positions, so a cost that rises or falls steadily over the probe (a
+ * cloth coming into contact) favours neither. The probed count wins only
+ * when it wins both blocks. */
+static const int32_t PROBE_ORDER[WC_TUNER_PROBE_STEPS] = {0, 1, 1, 0, 0, 1, 1, 0};
+
+static double min2(double a, double b) { return a < b ? a : b; }
+static double max2(double a, double b) { return a > b ? a : b; }
+
+static double median3(const double *t)
+{
+    return max2(min2(t[0], t[1]), min2(max2(t[0], t[1]), t[2]));
+}
+
+void wc_thread_tuner_create(wc_thread_tuner *t, int32_t most, int32_t adapt)
+{
+    t->most = most < 1 ? 1 : most;
+    t->adapt = adapt && t->most > 1;
+    t->chosen = t->current = t->adapt ? 1 : t->most;
+    t->probed = 0;
+    t->period = t->until_probe = FIRST_PERIOD;
+    t->direction = 1;
+    t->warmup = 2;
+    t->recent_count = t->recent_next = t->probe_step = 0;
+    t->reference = 0.0;
+}
+
+int32_t wc_thread_tuner_threads(const wc_thread_tuner *t) { return t->current; }
+
+/* The neighbouring count of the chosen one that way, or 0 when there is
+ * none. */
+static int32_t neighbour(const wc_thread_tuner *t, int32_t direction)
+{
+    if (direction < 0) return t->chosen > 1 ? t->chosen / 2 : 0;
+    if (t->chosen >= t->most) return 0;
+    return 2 * t->chosen < t->most ? 2 * t->chosen : t->most;
+}
+
+static void start_probe(wc_thread_tuner *t)
+{
+    int32_t next = neighbour(t, t->direction);
+    if (!next) {
+        t->direction = -t->direction;
+        next = neighbour(t, t->direction);
+    }
+    t->direction = -t->direction; /* alternate, so both ways get tried */
+    t->probed = next;
+    t->probe_step = 0;
+    for (int k = 0; k < 2; ++k) t->block_chosen[k] = t->block_probed[k] = 0.0;
+    t->current = t->chosen; /* PROBE_ORDER[0] */
+}
+
+static void end_probe(wc_thread_tuner *t)
+{
+    double gain = t->probed < t->chosen ? 1.0 : MORE_THREADS_GAIN;
+    int won = 1;
+    for (int k = 0; k < 2; ++k) won &= t->block_probed[k] <= gain * t->block_chosen[k];
+    if (won) {
+        t->chosen = t->probed;
+        t->reference = 0.0;
+        t->recent_count = t->recent_next = 0;
+        t->period = FIRST_PERIOD;
+    } else {
+        /* the probed count's extra time per step, in chosen-count steps */
+        double chosen = t->block_chosen[0] + t->block_chosen[1];
+        double extra = chosen > 0.0 ? (t->block_probed[0] + t->block_probed[1]) / chosen - 1.0
+                                    : 0.0;
+        double wait = 0.5 * WC_TUNER_PROBE_STEPS * extra / PROBE_COST;
+        int32_t period = 2 * t->period < BACKOFF_PERIOD ? 2 * t->period : BACKOFF_PERIOD;
+        if (wait > period) period = wait < MAX_PERIOD ? (int32_t)wait : MAX_PERIOD;
+        t->period = period;
+    }
+    t->probed = 0;
+    t->current = t->chosen;
+    t->until_probe = t->period;
+}
+
+static void record_probe_step(wc_thread_tuner *t, double seconds)
+{
+    int32_t block = t->probe_step / 4;
+    if (PROBE_ORDER[t->probe_step]) t->block_probed[block] += seconds;
+    else t->block_chosen[block] += seconds;
+    if (++t->probe_step == WC_TUNER_PROBE_STEPS) {
+        end_probe(t);
+        return;
+    }
+    t->current = PROBE_ORDER[t->probe_step] ? t->probed : t->chosen;
+}
+
+void wc_thread_tuner_record(wc_thread_tuner *t, double seconds)
+{
+    if (!t->adapt) return;
+    if (t->warmup > 0) {
+        --t->warmup;
+        return;
+    }
+    if (t->probed) {
+        record_probe_step(t, seconds);
+        return;
+    }
+    t->recent[t->recent_next] = seconds;
+    t->recent_next = (t->recent_next + 1) % WC_TUNER_SAMPLES;
+    if (t->recent_count < WC_TUNER_SAMPLES) ++t->recent_count;
+    if (t->recent_count < WC_TUNER_SAMPLES) return;
+    double now = median3(t->recent);
+    if (t->reference <= 0.0) t->reference = now;
+    if (now > SLOWDOWN * t->reference) {
+        if (t->chosen > 1) {
+            t->until_probe = 0;
+            t->direction = -1;
+        }
+        t->reference = now;
+    }
+    if (--t->until_probe <= 0) start_probe(t);
+}

@@ -1,0 +1,191 @@
+/* The thread tuner (libwetcloth/thread_tuner.h), fed with made-up step
+ * times: it keeps the count that is faster, finds it again when the
+ * machine changes, and probes rarely once a count keeps winning. And a
+ * world whose thread count changes from step to step ends bitwise where a
+ * one-thread world ends (which is why the tuner may change it at all). */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "test_util.h"
+#include "thread_tuner.h"
+#include "wetcloth.h"
+#include "world.h"
+
+/* Step time on `threads` threads for a machine where `free_cores` cores
+ * are free: the work splits over the threads that find a core, and every
+ * thread beyond the free cores costs a scheduler tick at each barrier. */
+static double step_time(int32_t threads, int32_t free_cores, double work, double tick)
+{
+    int32_t running = threads < free_cores ? threads : free_cores;
+    return work / running + (threads > free_cores ? tick : 0.0);
+}
+
+typedef struct {
+    int32_t steps_at[17]; /* steps run on each count, 1 .. 16 */
+    int32_t last;         /* the count of the last step */
+} run_log;
+
+static run_log drive(wc_thread_tuner *t, int32_t steps, int32_t free_cores, double work,
+                     double tick)
+{
+    run_log log;
+    memset(&log, 0, sizeof log);
+    for (int32_t s = 0; s < steps; ++s) {
+        int32_t n = wc_thread_tuner_threads(t);
+        CHECK(n >= 1 && n <= t->most, "step %d: %d threads of at most %d", s, n, t->most);
+        ++log.steps_at[n];
+        log.last = n;
+        wc_thread_tuner_record(t, step_time(n, free_cores, work, tick));
+    }
+    return log;
+}
+
+/* An idle 2-core machine: the world starts on 1 thread, finds 2 faster
+ * and stays there; the probes of 1 thread grow rare. */
+static void idle_machine_keeps_two(void)
+{
+    wc_thread_tuner t;
+    wc_thread_tuner_create(&t, 2, 1);
+    run_log log = drive(&t, 5000, 2, 0.020, 0.004);
+    printf("idle 2 cores: %d steps on 2 threads, %d on 1\n", log.steps_at[2], log.steps_at[1]);
+    CHECK(log.last == 2, "ended on %d threads", log.last);
+    /* the first 32 steps (and the 2 of warm-up), then probes of 4 steps,
+     * the period doubling to 1024: 9 probes in 5000 steps */
+    CHECK(log.steps_at[1] <= 34 + 3 + 4 * 9, "%d steps on 1 thread", log.steps_at[1]);
+    CHECK(t.period == 1024, "period %d", (int)t.period);
+}
+
+/* One core busy with another program: 2 threads pay a tick per step and are
+ * slower than 1; the tuner moves to 1 within its first probe, and back to 2
+ * when the other program ends. */
+static void busy_core_moves_to_one_and_back(void)
+{
+    wc_thread_tuner t;
+    wc_thread_tuner_create(&t, 2, 1);
+    run_log busy = drive(&t, 2000, 1, 0.020, 0.030);
+    printf("one core busy: %d steps on 2 threads, %d on 1\n", busy.steps_at[2], busy.steps_at[1]);
+    CHECK(busy.last == 1, "busy: ended on %d threads", busy.last);
+    CHECK(busy.steps_at[2] < 60, "busy: %d steps on the slower 2 threads", busy.steps_at[2]);
+    run_log idle = drive(&t, 4000, 2, 0.020, 0.030);
+    printf("then idle: %d steps on 2 threads, %d on 1\n", idle.steps_at[2], idle.steps_at[1]);
+    CHECK(idle.last == 2, "idle again: ended on %d threads", idle.last);
+    /* the probe period had grown to 1024 while 2 threads kept losing */
+    CHECK(idle.steps_at[2] > 2500, "idle again: only %d steps on 2 threads", idle.steps_at[2]);
+}
+
+/* The machine gets busy after the tuner had settled on 2 threads with a
+ * long probe period: the slowdown brings the probe forward. */
+static void slowdown_brings_the_probe_forward(void)
+{
+    wc_thread_tuner t;
+    wc_thread_tuner_create(&t, 2, 1);
+    drive(&t, 20000, 2, 0.020, 0.030);
+    CHECK(t.period == 1024 && wc_thread_tuner_threads(&t) == 2, "settled: period %d, %d threads",
+          (int)t.period, (int)wc_thread_tuner_threads(&t));
+    run_log busy = drive(&t, 100, 1, 0.020, 0.030);
+    printf("busy after settling: %d of 100 steps on 2 threads\n", busy.steps_at[2]);
+    /* 3 steps to see the slowdown, a probe's 4 on the chosen count, and at
+     * most 3 more before the slowdown shows in the median */
+    CHECK(busy.last == 1 && busy.steps_at[2] <= 12, "%d steps on 2 threads, last %d",
+          busy.steps_at[2], busy.last);
+}
+
+/* 16 threads on a machine with 5 free cores: the ladder 16, 8, 4 finds 4
+ * (of the powers of two, the fastest: 8 threads would pay the tick). */
+static void sixteen_threads_find_the_free_cores(void)
+{
+    wc_thread_tuner t;
+    wc_thread_tuner_create(&t, 16, 1);
+    run_log log = drive(&t, 3000, 5, 0.080, 0.030);
+    printf("16 threads, 5 free cores: last %d; steps on 16/8/4/2/1: %d/%d/%d/%d/%d\n", log.last,
+           log.steps_at[16], log.steps_at[8], log.steps_at[4], log.steps_at[2], log.steps_at[1]);
+    CHECK(log.last == 4, "ended on %d threads", log.last);
+    CHECK(log.steps_at[4] > 2500, "only %d steps on 4 threads", log.steps_at[4]);
+}
+
+/* More threads are taken only when clearly faster, fewer when no slower. */
+static void ties_go_to_fewer_threads(void)
+{
+    wc_thread_tuner t;
+    wc_thread_tuner_create(&t, 2, 1);
+    for (int32_t s = 0; s < 500; ++s) wc_thread_tuner_record(&t, 0.01);
+    CHECK(t.chosen == 1, "equal times: %d threads chosen", (int)t.chosen);
+}
+
+static void off_or_one_thread_never_changes(void)
+{
+    wc_thread_tuner t;
+    wc_thread_tuner_create(&t, 4, 0);
+    run_log log = drive(&t, 500, 1, 0.02, 0.03);
+    CHECK(log.steps_at[4] == 500, "adapt off: %d of 500 steps on 4 threads", log.steps_at[4]);
+    wc_thread_tuner_create(&t, 1, 1);
+    log = drive(&t, 500, 4, 0.02, 0.03);
+    CHECK(log.steps_at[1] == 500, "one thread: %d of 500 steps on it", log.steps_at[1]);
+}
+
+/* A world whose steps run on 1, 2, 4, 3, ... threads in turn ends where a
+ * one-thread world ends, bit for bit (with self-collision and a collider). */
+static uint64_t run_world(int32_t switching)
+{
+    wc_world_def wd = wc_world_def_default();
+    wd.thread_count = 4;
+    wd.adapt_threads = 0;
+    wd.integrator = WC_INTEGRATOR_IMPLICIT;
+    wc_world *w = NULL;
+    wc_message msg;
+    if (wc_world_create(&wd, &w, &msg) != WC_OK) {
+        CHECK(0, "world: %s", msg.text);
+        return 0;
+    }
+    wc_grid_cloth_def def = wc_grid_cloth_def_default();
+    def.count_u = def.count_v = 72; /* above the threshold of the threaded loops */
+    def.center[2] = 0.4;
+    def.self_collision = 1;
+    int32_t id = -1;
+    CHECK(wc_world_add_grid_cloth(w, &def, &id) == WC_OK, "grid: %s", wc_world_last_error(w));
+    wc_convex_collider_def sphere = wc_convex_collider_def_default();
+    sphere.radius = 0.3;
+    int32_t collider = -1;
+    CHECK(wc_world_add_convex_collider(w, &sphere, &collider) == WC_OK, "sphere: %s",
+          wc_world_last_error(w));
+    static const int32_t counts[4] = {1, 2, 4, 3};
+    for (int32_t s = 0; s < 24; ++s) {
+        w->tuner.current = switching ? counts[s % 4] : 1;
+        CHECK(wc_world_advance(w, 1.0 / 240.0, 1) == WC_OK, "step %d: %s", s,
+              wc_world_last_error(w));
+        CHECK(wc_world_get_stats(w).threads == w->tuner.current, "step %d ran on %d threads", s,
+              wc_world_get_stats(w).threads);
+    }
+    int32_t n = wc_cloth_particle_count(w, id);
+    double *x = malloc(3 * (size_t)n * sizeof *x);
+    wc_cloth_get_positions(w, id, x, n);
+    uint64_t h = 14695981039346656037ULL;
+    const unsigned char *b = (const unsigned char *)x;
+    for (size_t k = 0; k < 3 * (size_t)n * sizeof *x; ++k) h = (h ^ b[k]) * 1099511628211ULL;
+    free(x);
+    wc_world_destroy(w);
+    return h;
+}
+
+static void changing_counts_give_the_same_bits(void)
+{
+    uint64_t one = run_world(0), switching = run_world(1);
+    printf("24 steps on 1 thread: %016llx; on 1, 2, 4, 3 in turn: %016llx\n",
+           (unsigned long long)one, (unsigned long long)switching);
+    CHECK(one == switching && one != 0, "the thread count changed the result");
+}
+
+int main(void)
+{
+    idle_machine_keeps_two();
+    busy_core_moves_to_one_and_back();
+    slowdown_brings_the_probe_forward();
+    sixteen_threads_find_the_free_cores();
+    ties_go_to_fewer_threads();
+    off_or_one_thread_never_changes();
+    changing_counts_give_the_same_bits();
+    return test_report("test_thread_tuner");
+}
