@@ -1,4 +1,4 @@
-/* Forces on a cloth's particles (SPEC 1.3): tension-only stretch links with
+/* Forces on a cloth's particles (docs/model.md, Forces): tension-only stretch links with
  * damping, compression-only buckling links, gravity and air drag. */
 #ifndef WC_FORCES_H
 #define WC_FORCES_H

@@ -1,4 +1,4 @@
-/* Guard against steps above what the integrator keeps stable (issue 8:
+/* Guard against steps above what the integrator keeps stable (
  * "with a forced step it must fail cleanly").
  *
  * An explicit step above 2 / omega of some mode makes that mode grow by a

@@ -232,7 +232,7 @@ static int32_t straightest(const double *xyz, const int32_t *list, int32_t begin
     return best;
 }
 
-/* Bend links (SPEC 1.2): (a, c) when (a, b) and (b, c) are stretch links,
+/* Bend links: (a, c) when (a, b) and (b, c) are stretch links,
  * the rest angle a-b-c is at least 150 degrees, and each is the other's
  * straightest continuation through b. On any regular grid, square cells or
  * not, this is exactly the thesis' "skip one" set. The angle alone is not

@@ -1,4 +1,4 @@
-/* Cloth topology, built once from the rest shape (SPEC 1.2): particle areas,
+/* Cloth topology, built once from the rest shape (docs/model.md, Particles and links): particle areas,
  * stretch links (mesh edges and quad diagonals), bend links (the 150-degree
  * rule), and the surface triangles. Material-free: the cloth turns the area
  * shares into stiffnesses, so a material can change without a rebuild. */

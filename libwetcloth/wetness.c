@@ -70,7 +70,7 @@ void wc_wet_forces(wc_cloth *c, int threads)
 /* Self-adhesion                                                            */
 /* ------------------------------------------------------------------------ */
 
-/* Wet cloth touching wet cloth (SPEC 3): the water between two layers pulls
+/* Wet cloth touching wet cloth: the water between two layers pulls
  * them together with equal and opposite forces. The self-collision's
  * vertex-face pairs carry it: a vertex v at distance ~h from a point
  * sum b_k X_k of a triangle of another layer, n the unit normal from that

@@ -1,4 +1,4 @@
-/* The wet response (thesis 2.3-2.4, SPEC 3): adhesion of particles in
+/* The wet response (thesis 2.3-2.4; docs/wetness.md): adhesion of particles in
  * contact, spreading of the pull to their linked neighbours, which particles
  * are stuck, and the optional wetness dynamics (wicking, drying). Wet
  * friction lives in the collision response (collide.c), where the

@@ -1,5 +1,5 @@
 """Every row of docs/robustness.md's bad-input tables names a test, and every
-test it names exists (ctest test `docs_robustness_table`, issue 9).
+test it names exists (ctest test `docs_robustness_table`).
 
 A row's last cell names tests as the table's key says: `test_x: f` is the
 function f in tests/test_x.c, `python_y: f` the function f in the pytest file

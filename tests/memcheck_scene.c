@@ -1,4 +1,4 @@
-/* A short full scene for valgrind memcheck (issue 9; ctest memcheck_scene,
+/* A short full scene for valgrind memcheck (ctest memcheck_scene,
  * when valgrind is installed): a soaked, self-colliding 16 x 16 cloth with a
  * moving pinned corner falls onto the thesis sphere (mesh collider) beside
  * a box and a convex hull, plus a dry triangle-mesh cloth, for 0.1 s of

@@ -1,4 +1,4 @@
-/* Bad input (SPEC 5.1, 4): every invalid argument gives its status and a
+/* Bad input (docs/robustness.md): every invalid argument gives its status and a
  * message that names the problem, and changes nothing: after each failed
  * call the world is compared bitwise with a twin world that never saw the
  * call, and both are stepped on to show that the hidden state (velocities,

@@ -1,4 +1,4 @@
-/* Choi & Ko buckling model (SPEC 1.3, libwetcloth/buckling.h):
+/* Choi & Ko buckling model (libwetcloth/buckling.h; docs/model.md, Forces):
  *  - inverse sinc against 50+-digit mpmath references, to a few ulps of theta;
  *  - a dense residual sweep against an independent long double evaluation;
  *  - the force: onset and full-fold limits, references at interior points,
@@ -55,7 +55,7 @@ static double ulps(double value, double reference)
 
 static void test_inverse_sinc_references(void)
 {
-    /* The five points SPEC 1.3 names, as doubles r. Near r = 1 the problem
+    /* The five points the model asks for (r = 1-1e-15, 1-1e-8, 0.5, 1e-9, 0), as doubles r. Near r = 1 the problem
      * is ill-conditioned in r (d theta / d r ~ -3 / theta), but 1 - r is
      * exact for these doubles (Sterbenz), so the reference is theta for the
      * exact value of the double r, and wc_inverse_sinc must hit it. */

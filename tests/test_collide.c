@@ -1,4 +1,4 @@
-/* Cloth against colliders (issue 3): resting at the contact distance on a
+/* Cloth against colliders: resting at the contact distance on a
  * triangle and on every convex shape, a 100 m/s particle against a thin
  * triangle, a thin plate at 20 m/s through a hanging cloth, the thesis scene
  * without intersections, and determinism across thread counts. */

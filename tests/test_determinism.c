@@ -1,4 +1,4 @@
-/* Determinism (SPEC 4, 5.2): the same input gives bitwise the same output for
+/* Determinism: the same input gives bitwise the same output for
  * any number of threads, and for repeated runs.
  *
  * Scene: a 64 x 64 cloth (4096 particles: at WC_PARALLEL_MIN, so the

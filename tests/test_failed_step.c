@@ -1,4 +1,4 @@
-/* A failed step leaves no trace (issue 9, "a failing step keeps the last
+/* A failed step leaves no trace ("a failing step keeps the last
  * good state"), for each integrator.
  *
  * Two twin worlds, A and B, get the same calls: a soaked, self-colliding

@@ -1,4 +1,5 @@
-/* Hard cases (issue 8, SPEC 4), short versions. Each is a scene with a pass
+/* Hard cases (what "stable" means: large steps, stiffness, stretch, folds, fast
+ * thin colliders, pins under load, degenerate input), short versions. Each is a scene with a pass
  * criterion:
  *   - finite: every position finite after every call, successful or not;
  *   - a failed step is WC_ERROR_NON_FINITE and leaves the state bitwise as

@@ -1,4 +1,4 @@
-/* Position Verlet against closed forms and convergence (SPEC 1.4, 4):
+/* Position Verlet against closed forms and convergence :
  *   (a) free fall of a whole cloth = x0 + v0 t + g t^2 / 2 to rounding;
  *   (b) a particle hanging from two pinned ones: period 2 pi sqrt(m / U'')
  *       with U'' derived below;
@@ -51,7 +51,7 @@ static double wall_seconds(void)
  * oscillates at the link frequency with rounding amplitude. Hence 1e-10.
  *
  * Run with bend_stiffness 0 (the integrator alone) and with the default
- * material (SPEC 1.4: free fall matches g t^2 / 2 to rounding). The buckling
+ * material (free fall matches g t^2 / 2 to rounding). The buckling
  * force jumps from 0 to 12 R / l^2 as soon as a bend link is shorter than its
  * rest length, so with bending on, a rounding-level shortening of a bend
  * link in a rigidly falling cloth produces a finite force. */
@@ -545,7 +545,7 @@ static void test_hanging_convergence(void)
           "sag %.6f outside [%.4f, %.4f]", r[2].bottom_drop, rho_g / 20.0, rho_g / 16.0);
 }
 
-/* The same sheet with the default bending stiffness (SPEC 1.3: the same
+/* The same sheet with the default bending stiffness (the same
  * material gives nearly the same drape at any resolution). Cheaper levels,
  * 16 / 32 / 64 cells, each allowed 3 s of simulated time to settle.
  *

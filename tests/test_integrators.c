@@ -1,4 +1,4 @@
-/* The three integrators side by side (issue 7):
+/* The three integrators side by side:
  *   1. free fall against the closed form, with equal steps and with steps
  *      of two lengths in turn: exact for all three (XPBD's prediction is
  *      Verlet's; the implicit integrator's positions take the share of the
@@ -187,7 +187,7 @@ static double hang(wc_integrator integrator, int32_t substeps, double *out)
     return e.kinetic;
 }
 
-/* Criterion (issue 7): every particle within 1 % of the cloth's size (1 cm)
+/* Criterion: every particle within 1 % of the cloth's size (1 cm)
  * of Verlet's rest shape. Verlet's reference runs at a tenth of its stable
  * step (its automatic substeps times 10, 910 per frame). The implicit
  * integrator runs at 5 steps per frame (1/120 s, 18 times Verlet's stable
@@ -418,7 +418,7 @@ static void wrap(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* 7. Convergence under step refinement (issue 8's error measure)           */
+/* 7. Convergence under step refinement (the project's error measure)           */
 /* ------------------------------------------------------------------------ */
 
 /* The thesis drape at DRAPE_N^2 (1 m cloth 0.6 m above the 114-vertex
@@ -459,7 +459,7 @@ static double drape_error(wc_integrator integrator, int32_t substeps)
 
 /* The large-step integrators' answers converge as the step shrinks: the
  * error falls at each halving of the step and is below DRAPE_BOUND at 20
- * steps per frame, issue 7's error target of 1 % of the cloth's size (measured 6.3e-3 for
+ * steps per frame, the error target of 1 % of the cloth's size (measured 6.3e-3 for
  * XPBD and 8.1e-3 for the implicit integrator). This caught XPBD without its slack-link dashpots, whose
  * error stayed at about 1 % from 20 to 160 steps per frame (the undamped
  * compressed links let wrinkles grow differently at every step length). */

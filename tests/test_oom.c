@@ -1,4 +1,4 @@
-/* Failure containment (issue 9): every allocation of the library goes
+/* Failure containment: every allocation of the library goes
  * through the hook of wc_set_allocator(), and this test makes each one fail
  * in turn, during world creation, while adding cloths, colliders, pins
  * (hard and soft) and the applied force fields (air velocity, external

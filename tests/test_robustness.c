@@ -1,4 +1,4 @@
-/* Regressions found by fuzzing (issue 9, tests/fuzz): each case is what a
+/* Regressions found by fuzzing (tests/fuzz): each case is what a
  * fuzz input reduced to, checked in the normal and the sanitizer builds. */
 #include <math.h>
 #include <string.h>

@@ -1,4 +1,4 @@
-/* Self-collision (libwetcloth/selfcollide.c, SPEC 2):
+/* Self-collision (libwetcloth/selfcollide.c):
  *  (a) a vertex thrown through a face in one step is stopped on its own side,
  *      at least the thickness away;
  *  (a') a particle a collider pass pushed into the band over a face stays at

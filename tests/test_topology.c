@@ -1,4 +1,4 @@
-/* Cloth topology (SPEC 1.2) and the material mapping (wetcloth.h,
+/* Cloth topology (docs/model.md, Particles and links) and the material mapping (wetcloth.h,
  * wc_material): link sets computed independently from grid coordinates or
  * by hand for small meshes, rest lengths, particle areas and masses, per-link
  * K and R, surface triangles, and the tension-only stretch force. */
@@ -452,7 +452,7 @@ static void test_tension_only(void)
     wc_world_destroy(w);
 }
 
-/* SPEC 1.2: on a grid the bend links are the skip-one set. With cells of
+/* On a grid the bend links are the skip-one set. With cells of
  * aspect ratio above sqrt(3), the 150-degree rule also links an axis
  * neighbour to the opposite diagonal neighbour (angle atan(hu/hv) + 90 >
  * 150 degrees), so this case checks that the grid keeps the thesis' set. */

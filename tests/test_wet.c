@@ -1,4 +1,4 @@
-/* Wet cloth (SPEC 3 and 6; thesis 2.3-2.4 and 3.2-3.7):
+/* Wet cloth (docs/wetness.md; thesis 2.3-2.4 and 3.2-3.7):
  *   1. a dry cloth (wetness 0) is bit for bit the plain model, whatever the
  *      wet parameters;
  *   2. wrap: the thesis scene, wet against dry (Fig. 3.2-3.4);
@@ -82,7 +82,7 @@ static uint64_t small_drop(const wc_material *m, double wetness)
     return h;
 }
 
-/* SPEC 3: "Dry cloth (w = 0) must behave exactly as the plain cloth model".
+/* Dry cloth (w = 0) must behave exactly as the plain cloth model.
  * The same drop with the default wet material, with every wet parameter
  * zeroed (adhesion 0, spread 0, wet_friction 1, wet_mass_gain 0,
  * wet_softening 0) and with all of them at extremes (wicking and drying on,
@@ -205,7 +205,7 @@ static wrap_result wrap_run(double wetness)
  *  - wet edge radius (mean and last frame) < R - 1.5 cm = 0.285: clearly
  *    inside the equator (measured 0.274, 2.6 cm inside);
  *  - no intersection at any frame in either.
- * Contact hold (SPEC 3: adhesion acts "every step while in contact, so it
+ * Contact hold (adhesion acts "every step while in contact, so it
  * touches again next step"), measured over every step of frames 13-18, when
  * the wet cloth has settled: of the particle-steps with the particle resting
  * on the sphere (within RESTING of its faces, by brute force), the fraction

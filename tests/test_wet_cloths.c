@@ -1,4 +1,4 @@
-/* Wet adhesion between different cloths (SPEC 3, self-adhesion; issue 8's
+/* Wet adhesion between different cloths (the self-adhesion law, between
  * two cloths): cloths of one world that collide with each other
  * (collide_with_cloths) stick together when wet, by the self-adhesion law
  * applied across them (wetness.c, cloth_group.c):

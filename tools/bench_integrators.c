@@ -1,5 +1,5 @@
 /* The three integrators on the thesis drape: wall time per simulated frame
- * against error, measured as issue 8 defines it (issue 7's targets).
+ * against error, by the project's error protocol (docs/benchmarks.md).
  *
  *   build/tools/bench_integrators [options]
  *     seconds=0.5        simulated time (frames of 1/24 s)
@@ -8,7 +8,7 @@
  *                        step may run on fewer threads when measured faster;
  *                        0 runs exactly `threads`
  *     sizes=20,101       n of the n x n grid cloths (101^2 = 10,201 particles,
- *                        the size of Blender's figures in NOTES)
+ *                        the size of Blender's figures below)
  *     self=0,1           self-collision off, on
  *     integrators=verlet,xpbd,implicit
  *     steps=2,3,5,8,12,20,30,50   substeps per frame swept for xpbd and
@@ -29,14 +29,14 @@
  * Scene: an n x n grid cloth (default cotton), 1 m wide, 0.6 m above the
  * 114-vertex UV sphere (radius 0.3 m), falling onto it.
  *
- * Error (issue 8): RMS over particles and frames of the distance between the
+ * Error: RMS over particles and frames of the distance between the
  * run and a reference run of the same scene and integrator at an 8x smaller
  * step, at the same frame times, divided by the cloth's size (1 m). The
  * column "vs verlet" is the same measure against Verlet at its automatic
  * step, to show where the large-step integrators' answer lies.
  *
  * Cost: wall milliseconds per simulated frame (one run each; the machine may
- * be shared: report its load). Blender's cloth on the same scene (NOTES, bpy
+ * be shared: report its load). Blender's cloth on the same scene (bpy
  * 4.5.4, quality 5, this machine): 9.9 / 11.4 ms per frame at 400 particles
  * (self-collision off / on), 220 / 2752 at 10,201; "x blender" divides those
  * by ours for the sizes they were measured at. The summary picks, per
@@ -161,7 +161,8 @@ static double rms_error(const run_result *a, const run_result *b)
     return sqrt(sum / ((double)a->frames * a->n)) / 1.0;
 }
 
-/* Blender's ms per frame on the same scene (NOTES), 0 where not measured. */
+/* Blender's ms per frame on the same scene, measured through bpy 4.5 on the
+ * development machine (docs/benchmarks.md), 0 where not measured. */
 static double blender_ms(int size, int self)
 {
     if (size == 20) return self ? 11.4 : 9.9;
@@ -315,7 +316,7 @@ int main(int argc, char **argv)
            "to round-off), / 1 m; "
            "vs verlet: the same against Verlet at its automatic step. ms per simulated frame, "
            "its CPU time (cpu ms, all threads), the phases forces / integration / collisions (wall). x blender: Blender's ms per frame "
-           "(NOTES) / ours. cg/step: the implicit integrator's conjugate-gradient iterations per substep.\n\n",
+           "(measured through bpy) / ours. cg/step: the implicit integrator's conjugate-gradient iterations per substep.\n\n",
            o.seconds, (int)lround(o.seconds * 24), o.threads,
            o.adapt ? " at most (adapt=1)" : " exactly (adapt=0)", o.tolerance);
     printf("%-9s %-4s %-9s %8s %10s %8s %7s %7s %7s %10s %10s %9s %8s\n", "particles", "self",

@@ -1,4 +1,4 @@
-/* Thread scaling (issue 8): particle-steps per second of a cloth resting on
+/* Thread scaling: particle-steps per second of a cloth resting on
  * a ground plate (bench_util's resting scene: link length 1/63 m, every
  * particle in contact), 32^2 to 512^2 particles (1k to 262k), self-collision
  * off and on, for each thread count given, all measured in this run.

@@ -1,4 +1,4 @@
-/* libFuzzer target for the C API (issue 9). The input bytes are a little
+/* libFuzzer target for the C API (docs/robustness.md). The input bytes are a little
  * program: a world description, then up to MAX_OPS calls (add mesh or grid
  * cloths, mesh and convex colliders, pins, pin targets, positions,
  * velocities, wetness, collider motion, steps and advances, and the

@@ -1,4 +1,4 @@
-"""Fuzz target for the scene-file loader (issue 9): wetcloth.scene.load and
+"""Fuzz target for the scene-file loader: wetcloth.scene.load and
 wetcloth.scene.build may raise SceneError, with a non-empty message, and
 nothing else, whatever the file holds.
 

@@ -1,4 +1,4 @@
-"""Blender's cloth and libwetcloth side by side, in one process (issue 8).
+"""Blender's cloth and libwetcloth side by side, in one process.
 
 Run by report.py under the Python that has bpy 4.5 (.venv-blender), with
 PYTHONPATH giving the wetcloth package (and cffi) and WETCLOTH_LIBRARY the

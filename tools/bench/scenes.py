@@ -1,4 +1,4 @@
-"""Scenes of the measurement suite (issue 8), built with the wetcloth binding.
+"""Scenes of the measurement suite, built with the wetcloth binding.
 
 Python holds no physics here: these functions only place cloths and
 colliders; every number comes from libwetcloth.
