@@ -1,4 +1,4 @@
-/* Position Verlet against closed forms and convergence :
+/* Position Verlet against closed forms and convergence:
  *   (a) free fall of a whole cloth = x0 + v0 t + g t^2 / 2 to rounding;
  *   (b) a particle hanging from two pinned ones: period 2 pi sqrt(m / U'')
  *       with U'' derived below;
