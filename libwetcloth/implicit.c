@@ -6,6 +6,7 @@
 #include "alloc.h"
 #include "buckling.h"
 #include "integrate.h"
+#include "invariant.h"
 #include "multigrid.h"
 #include "parallel.h"
 #include "primitives.h"
@@ -602,6 +603,9 @@ static int positions_range(void *context, int64_t begin, int64_t end)
 int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, double tolerance,
                               int threads)
 {
+    WC_ASSERT(c->implicit != NULL);
+    WC_ASSERT(dt > 0.0 && pin_fraction >= 0.0 && pin_fraction <= 1.0 && tolerance >= 0.0 &&
+              threads >= 1);
     wc_implicit_state *s = c->implicit;
     int32_t n = c->particle_count;
     int particle_threads = wc_threads_for(n, threads);

@@ -37,7 +37,8 @@ double wc_implicit_last_residual(const wc_implicit_state *state);
 /// particles go where Verlet puts them. The solve stops when its estimated
 /// velocity error is at most tolerance * dt (wc_world_def.implicit_tolerance,
 /// m/s^2; 0: to round-off). Returns the index of the first particle whose
-/// new position is not finite, or -1 when all are. cloth->implicit must exist.
+/// new position is not finite, or -1 when all are. cloth->implicit must exist
+/// (asserted).
 int32_t wc_integrate_implicit(wc_cloth *cloth, double dt, double pin_fraction, double tolerance,
                               int threads);
 

@@ -1,5 +1,7 @@
 #include "thread_tuner.h"
 
+#include "invariant.h"
+
 /* A world starts on one thread and first tries more after FIRST_PERIOD
  * steps: on a busy machine a step on more threads can take many times
  * longer (15x was measured here, at 4 runnable processes on 2 cores), and
@@ -114,6 +116,7 @@ static void record_probe_step(wc_thread_tuner *t, double seconds)
 
 void wc_thread_tuner_record(wc_thread_tuner *t, double seconds)
 {
+    WC_ASSERT(t->current >= 1 && t->current <= t->most);
     if (!t->adapt) return;
     if (t->warmup > 0) {
         --t->warmup;

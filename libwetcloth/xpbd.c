@@ -5,6 +5,7 @@
 
 #include "alloc.h"
 #include "integrate.h"
+#include "invariant.h"
 #include "parallel.h"
 
 /* Colours 0 .. GREEDY_COLORS - 1 come from a greedy colouring with one bit
@@ -185,6 +186,8 @@ static void sweep(wc_cloth *c, link_colors *lc, double h, int slack, int threads
 
 int32_t wc_integrate_xpbd(wc_cloth *c, double dt, double pin_fraction, int threads)
 {
+    WC_ASSERT(c->xpbd != NULL);
+    WC_ASSERT(dt > 0.0 && pin_fraction >= 0.0 && pin_fraction <= 1.0 && threads >= 1);
     int32_t bad = wc_integrate_verlet(c, dt, pin_fraction, threads);
     if (bad >= 0) return bad;
     wc_xpbd_state *st = c->xpbd;

@@ -27,7 +27,7 @@ int32_t wc_xpbd_color_count(const wc_xpbd_state *state);
 /// projections over the taut ones. Pinned particles are placed as in Verlet
 /// and never moved by a projection.
 /// Returns the index of the first particle whose new position is not
-/// finite, or -1 when all are. cloth->xpbd must exist.
+/// finite, or -1 when all are. cloth->xpbd must exist (asserted).
 int32_t wc_integrate_xpbd(wc_cloth *cloth, double dt, double pin_fraction, int threads);
 
 #endif
