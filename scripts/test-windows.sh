@@ -14,7 +14,9 @@
 #   * python_extension_zip: the Windows Blender extension zip's cffi wheel
 #     and wetcloth.dll load there and simulate;
 #   * tests/consumer, built against the installed package (CMake config,
-#     shared and static), runs.
+#     shared and static), runs;
+#   * `pip wheel .` through scikit-build-core with the MinGW toolchain: the
+#     wheel's package loads wetcloth.dll in Windows' CPython and steps.
 #
 #   scripts/test-windows.sh            (called by scripts/test.sh)
 #
@@ -133,6 +135,35 @@ for kind in shared static; do
         status=1
     }
 done
+
+# `pip install .`'s wheel, built by scikit-build-core through the same CMake
+# with the MinGW toolchain (the tag says linux_x86_64 here, win_amd64 on
+# Windows): it holds wetcloth.dll and _ffi.py, and imports and steps in
+# Windows' CPython.
+say "pip wheel . with the MinGW toolchain"
+wheel_dir=$root/build-windows-x64/wheel
+rm -rf "$wheel_dir"
+if "$host_python" -m pip wheel . -q --disable-pip-version-check --no-deps --no-build-isolation \
+        -w "$wheel_dir" -Cbuild-dir="$root/build-windows-x64/pip" \
+        -Ccmake.define.CMAKE_TOOLCHAIN_FILE="$root/cmake/toolchains/windows-x64-mingw.cmake" \
+        -Ccmake.define.CMAKE_PREFIX_PATH="$root/build-windows-x64/prefix" \
+        -Ccmake.define.ccd_DIR="$root/build-windows-x64/prefix/lib/ccd" &&
+    "$host_python" -c 'import glob, sys, zipfile; zipfile.ZipFile(glob.glob(sys.argv[1] + "/*.whl")[0]).extractall(sys.argv[1] + "/unpacked")' "$wheel_dir" &&
+    "$winpy/python" -E -c '
+import os, sys
+sys.path.insert(0, sys.argv[1])
+import wetcloth
+assert os.path.basename(wetcloth.library_path) == "wetcloth.dll", wetcloth.library_path
+world = wetcloth.World()
+cloth = world.add_grid_cloth(10, 10)
+world.advance(1 / 24)
+print("test-windows: the wheel'"'"'s package loads %s and steps (lowest z %.6f m)" % (wetcloth.library_path, cloth.positions[:, 2].min()))
+' "$wheel_dir/unpacked"; then
+    :
+else
+    echo "test-windows: the wheel built with the MinGW toolchain failed" >&2
+    status=1
+fi
 
 echo "test-windows: ctest under wine took $ctest_seconds s;" \
      "the whole Windows part $(( $(date +%s) - started )) s"
