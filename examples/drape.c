@@ -20,6 +20,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "replace_file.h"
+
 #define GRID_N 32
 #define FPS 24
 
@@ -71,7 +73,7 @@ static int write_obj(const char *path, const double *xyz, int32_t vertex_count,
         free(tmp);
         return 0;
     }
-    if (rename(tmp, path) != 0) {
+    if (replace_file(tmp, path) != 0) {
         fprintf(stderr, "drape: cannot rename %s to %s: %s\n", tmp, path, strerror(errno));
         remove(tmp);
         free(tmp);

@@ -24,6 +24,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "replace_file.h"
+
 #define GRID_N 20
 #define FPS 24
 #define RADIUS 0.3
@@ -91,7 +93,7 @@ static int write_obj(const char *path, const char *object, const double *xyz, in
         fprintf(f, "f %d %d %d\n", (int)tris[3 * i] + 1, (int)tris[3 * i + 1] + 1, (int)tris[3 * i + 2] + 1);
     int good = !ferror(f);
     good &= fclose(f) == 0;
-    if (good && rename(tmp, path) != 0) {
+    if (good && replace_file(tmp, path) != 0) {
         fprintf(stderr, "wet_dry: cannot rename %s to %s: %s\n", tmp, path, strerror(errno));
         good = 0;
     } else if (!good) {

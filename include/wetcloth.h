@@ -25,8 +25,15 @@
 extern "C" {
 #endif
 
-#if defined(_WIN32) && defined(WC_BUILD_SHARED)
+/* The library exports exactly the functions marked WC_API (it is built with
+ * WC_BUILD_SHARED and hidden visibility). A program that uses the DLL needs
+ * no dllimport: the import library resolves the calls. */
+#if defined(_WIN32)
+#if defined(WC_BUILD_SHARED)
 #define WC_API __declspec(dllexport)
+#else
+#define WC_API
+#endif
 #elif defined(__GNUC__)
 #define WC_API __attribute__((visibility("default")))
 #else

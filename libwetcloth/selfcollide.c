@@ -1079,6 +1079,7 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
 {
     double h = ctx->h;
     int32_t n = s->particle_count, nt = s->triangle_count, np = s->patch_count;
+    (void)threads;
 #pragma omp parallel for schedule(static) num_threads(threads) if (n >= WC_PARALLEL_MIN)
     for (int32_t i = 0; i < n; ++i) particle_box(c, i, g, s->particle_boxes + 6 * (size_t)i);
 #pragma omp parallel for schedule(static) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
@@ -1415,6 +1416,7 @@ static void evaluate(wc_self_state *s, const self_ctx *ctx, int ccd_only, int th
 {
     const uint8_t *dirty = s->dirty;
     int64_t nvf = s->vf_count, nee = s->ee_count;
+    (void)threads;
 #pragma omp parallel for schedule(static) num_threads(threads) if (nvf >= WC_PARALLEL_MIN)
     for (int64_t i = 0; i < nvf; ++i) {
         const int32_t *pr = s->vf + 2 * i, *tri = s->triangles + 3 * (size_t)pr[1];
@@ -1608,6 +1610,7 @@ static int still_valid(wc_self_state *s, const wc_cloth *c, int threads)
     }
     const csr *pp = &s->patch_particles, *adj = &s->patch_adjacent;
     int any = 0;
+    (void)threads;
     /* Each patch writes only its own triangles' normals and its own cone. */
 #pragma omp parallel for schedule(static) num_threads(threads) if (s->triangle_count >= WC_PARALLEL_MIN) \
     reduction(| : any)

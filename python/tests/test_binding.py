@@ -96,9 +96,11 @@ def test_a_binding_from_another_header_is_refused_by_name():
     assert "pip install ." in text
 
     # a library from before wc_struct_size, loaded as the package loads one
-    # (libc stands in: it has no wc_ symbols either)
+    # (the C library stands in: it has no wc_ symbols either; Windows has
+    # none by that name, and find_library("c") finds none there)
     import ctypes.util
-    old = wetcloth.ffi.dlopen(ctypes.util.find_library("c"))
+    old = wetcloth.ffi.dlopen("kernel32.dll" if sys.platform == "win32"
+                              else ctypes.util.find_library("c"))
     with pytest.raises(ImportError, match="has no wc_struct_size"):
         _lib.check_struct_sizes(old, wetcloth.ffi, "/old/libwetcloth.so")
 

@@ -4,7 +4,9 @@ The library is looked for, in this order:
 
 1. the file named by the environment variable WETCLOTH_LIBRARY, if set
    (it must exist: a wrong path is an error, not a fallback);
-2. ``libwetcloth.so`` in each folder of the package's ``__path__``: where
+2. ``libwetcloth.so`` (Linux), ``libwetcloth.dylib`` (macOS) or
+   ``wetcloth.dll`` (Windows; ``libwetcloth.dll`` as MinGW names it by
+   default) in each folder of the package's ``__path__``: where
    ``pip install .`` puts it, also for editable installs, whose ``__path__``
    spans the source tree and the installed files.
 """
@@ -14,7 +16,7 @@ import os
 from ._ffi import ffi
 
 ENV_VAR = "WETCLOTH_LIBRARY"
-LIBRARY_NAMES = ("libwetcloth.so", "libwetcloth.dylib", "wetcloth.dll")
+LIBRARY_NAMES = ("libwetcloth.so", "libwetcloth.dylib", "wetcloth.dll", "libwetcloth.dll")
 REINSTALL = ("Install the package and its library together ('pip install .' at the repository "
              "root, or scripts/setup.sh), or point %s at the library built with this "
              "binding" % ENV_VAR)
