@@ -5,7 +5,7 @@
 
 #include "alloc.h"
 #include "buckling.h"
-#include "collide_features.h"
+#include "collider_contacts.h"
 #include "implicit.h"
 #include "selfcollide.h"
 #include "status.h"
@@ -36,7 +36,7 @@ void wc_cloth_destroy(wc_cloth *c)
     wc_free(c->adhesive_pairs);
     wc_free(c->adhesive_data);
     wc_self_state_destroy(c->self);
-    wc_feature_state_destroy(c->features);
+    wc_collider_contacts_destroy(c->collider_contacts);
     wc_xpbd_state_destroy(c->xpbd);
     wc_implicit_state_destroy(c->implicit);
     wc_topology_free(&c->topology);

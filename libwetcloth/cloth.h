@@ -115,9 +115,9 @@ typedef struct wc_cloth {
     /// Whether the cloth collides with the world's other cloths that do
     /// (cloth_group.h).
     int collide_cloths;
-    /// Buffers for collider vertices and edges against this cloth; made
-    /// at the first step with a mesh collider.
-    struct wc_feature_state *features;
+    /// Buffers of the collider contact stage (collider_contacts.h): made at
+    /// the first step with a collider.
+    struct wc_collider_contacts *collider_contacts;
 
     /* Wetness. */
     /// Wetness of each particle, [0, 1].

@@ -8,6 +8,7 @@
 
 #include "alloc.h"
 #include "convex.h"
+#include "primitives.h"
 #include "status.h"
 #include "world.h"
 
@@ -41,17 +42,12 @@ void wc_collider_destroy(wc_collider *c)
     wc_free(c->triangles);
     wc_free(c->edges);
     wc_free(c->triangle_edges);
-    wc_free(c->vertex_boxes);
-    wc_free(c->edge_boxes);
-    wc_grid_free(&c->vertex_grid);
-    wc_grid_free(&c->edge_grid);
     wc_free(c->current);
     wc_free(c->target);
     wc_free(c->next);
     wc_free(c->boxes);
-    wc_free(c->normal_current);
-    wc_free(c->normal_next);
-    wc_grid_free(&c->grid);
+    wc_free(c->normals);
+    wc_bvh_free(&c->bvh);
     wc_convex_shape_free(&c->convex);
     wc_free(c);
 }
@@ -64,8 +60,8 @@ static int compare_triples(const void *pa, const void *pb)
     return 0;
 }
 
-/* The unique edges of a mesh collider's triangles, sorted, each triangle's
- * three edge ids, and the feature pass's scratch. Entries (a, b, where) are
+/* The unique edges of a mesh collider's triangles, sorted, and each
+ * triangle's three edge ids. Entries (a, b, where) are
  * sorted so equal edges become neighbours; `where` is 3 * triangle + corner. */
 static int build_edges(wc_collider *c)
 {
@@ -73,9 +69,7 @@ static int build_edges(wc_collider *c)
     int32_t *entries = wc_alloc_array(3 * n, sizeof *entries);
     c->edges = wc_alloc_array(2 * n, sizeof *c->edges);
     c->triangle_edges = wc_alloc_array(n, sizeof *c->triangle_edges);
-    c->vertex_boxes = wc_alloc_array(6 * (size_t)c->vertex_count, sizeof *c->vertex_boxes);
-    c->edge_boxes = wc_alloc_array(6 * n, sizeof *c->edge_boxes);
-    if (!entries || !c->edges || !c->triangle_edges || !c->vertex_boxes || !c->edge_boxes) {
+    if (!entries || !c->edges || !c->triangle_edges) {
         wc_free(entries);
         return 0;
     }
@@ -178,19 +172,15 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
         c->friction = d->friction;
         c->vertex_count = d->vertex_count;
         c->triangle_count = d->triangle_count;
-        wc_grid_init(&c->grid);
-        wc_grid_init(&c->vertex_grid);
-        wc_grid_init(&c->edge_grid);
+        wc_bvh_init(&c->bvh);
         c->triangles = wc_alloc_array(3 * nt, sizeof *c->triangles);
         c->current = wc_alloc_array(nv, sizeof *c->current);
         c->target = wc_alloc_array(nv, sizeof *c->target);
         c->next = wc_alloc_array(nv, sizeof *c->next);
         c->boxes = wc_alloc_array(6 * nt, sizeof *c->boxes);
-        c->normal_current = wc_alloc_array(3 * nt, sizeof *c->normal_current);
-        c->normal_next = wc_alloc_array(3 * nt, sizeof *c->normal_next);
+        c->normals = wc_alloc_array(3 * nt, sizeof *c->normals);
     }
-    if (!c || !c->triangles || !c->current || !c->target || !c->next || !c->boxes ||
-        !c->normal_current || !c->normal_next) {
+    if (!c || !c->triangles || !c->current || !c->target || !c->next || !c->boxes || !c->normals) {
         wc_collider_destroy(c);
         return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
     }
@@ -213,9 +203,7 @@ wc_status wc_world_add_convex_collider(wc_world *w, const wc_convex_collider_def
                        "wc_world_add_convex_collider: %s is NULL", d ? "out_collider" : "def");
     wc_collider *c = wc_alloc_array(1, sizeof *c);
     if (!c) return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
-    wc_grid_init(&c->grid);
-    wc_grid_init(&c->vertex_grid);
-    wc_grid_init(&c->edge_grid);
+    wc_bvh_init(&c->bvh);
     wc_status s = wc_convex_shape_init(&c->convex, &c->pose_current, d, &w->error);
     if (s) {
         wc_collider_destroy(c);
@@ -256,6 +244,9 @@ wc_status wc_collider_set_vertices(wc_world *w, int32_t collider, const double *
                        "xyz"[bad % 3], xyz[bad]);
     memcpy(c->target, xyz, 3 * (size_t)count * sizeof *xyz);
     c->moving = memcmp(c->target, c->current, 3 * (size_t)count * sizeof *xyz) != 0;
+    /* the boxes must cover the new advance's motion */
+    c->indexed = 0;
+    c->normals_current = 0;
     return WC_OK;
 }
 
@@ -291,3 +282,108 @@ wc_status wc_collider_set_transform(wc_world *w, int32_t collider, const double 
 }
 
 int32_t wc_world_collider_count(const wc_world *w) { return w ? w->collider_count : 0; }
+
+/* ------------------------------------------------------------------------ */
+/* Colliders over a step                                                    */
+/* ------------------------------------------------------------------------ */
+
+static void grow_box(double box[6], const double *p)
+{
+    for (int k = 0; k < 3; ++k) {
+        if (p[k] < box[k]) box[k] = p[k];
+        if (p[k] > box[k + 3]) box[k + 3] = p[k];
+    }
+}
+
+/* Every triangle's box over the running advance (its corners now and at the
+ * target), and the tree over them: built the first time, refit after, so a
+ * deforming collider pays one pass over its triangles per advance. */
+static wc_status index_mesh(wc_collider *c)
+{
+    for (int32_t t = 0; t < c->triangle_count; ++t) {
+        double *box = c->boxes + 6 * (size_t)t;
+        for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
+        for (int k = 0; k < 3; ++k) {
+            size_t v = 3 * (size_t)c->triangles[3 * (size_t)t + k];
+            grow_box(box, c->current + v);
+            grow_box(box, c->target + v);
+        }
+    }
+    if (c->bvh.node_count == 0) {
+        if (wc_bvh_build(&c->bvh, c->boxes, c->triangle_count)) return WC_ERROR_OUT_OF_MEMORY;
+    } else {
+        wc_bvh_refit(&c->bvh);
+    }
+    memcpy(c->bounds, c->bvh.nodes[0].box, sizeof c->bounds);
+    c->indexed = 1;
+    return WC_OK;
+}
+
+static void static_normals(wc_collider *c)
+{
+    for (int32_t t = 0; t < c->triangle_count; ++t) {
+        const int32_t *v = c->triangles + 3 * (size_t)t;
+        wc_triangle_normal(c->current + 3 * (size_t)v[0], c->current + 3 * (size_t)v[1],
+                           c->current + 3 * (size_t)v[2], c->normals + 3 * (size_t)t);
+    }
+    c->normals_current = 1;
+}
+
+static wc_status mesh_begin_step(wc_collider *c, double share)
+{
+    size_t nv = 3 * (size_t)c->vertex_count;
+    c->step_motion = 0.0;
+    if (c->moving) {
+        if (share >= 1.0) memcpy(c->next, c->target, nv * sizeof *c->next); /* exactly there */
+        else
+            for (size_t k = 0; k < nv; ++k) c->next[k] = wc_lerp(c->current[k], c->target[k], share);
+        double most2 = 0.0;
+        for (size_t v = 0; v < nv; v += 3) {
+            double d[3] = {c->next[v] - c->current[v], c->next[v + 1] - c->current[v + 1],
+                           c->next[v + 2] - c->current[v + 2]};
+            double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if (d2 > most2) most2 = d2;
+        }
+        c->step_motion = sqrt(most2);
+    }
+    if (!c->indexed && index_mesh(c)) return WC_ERROR_OUT_OF_MEMORY;
+    if (!c->moving && !c->normals_current) static_normals(c);
+    return WC_OK;
+}
+
+static void convex_begin_step(wc_collider *c, double share)
+{
+    if (c->moving && share >= 1.0) c->pose_next = c->pose_target;
+    else if (c->moving) wc_pose_lerp(&c->pose_current, &c->pose_target, share, &c->pose_next);
+    else c->pose_next = c->pose_current;
+    const double *p0 = c->pose_current.position, *p1 = c->pose_next.position;
+    double r = c->convex.bound_radius;
+    for (int k = 0; k < 3; ++k) {
+        c->bounds[k] = fmin(p0[k], p1[k]) - r;
+        c->bounds[k + 3] = fmax(p0[k], p1[k]) + r;
+    }
+}
+
+wc_status wc_collider_begin_step(wc_collider *c, double share)
+{
+    if (c->is_mesh) return mesh_begin_step(c, share);
+    convex_begin_step(c, share);
+    return WC_OK;
+}
+
+void wc_collider_end_step(wc_collider *c)
+{
+    if (!c->moving) return;
+    if (c->is_mesh) {
+        size_t bytes = 3 * (size_t)c->vertex_count * sizeof *c->current;
+        memcpy(c->current, c->next, bytes);
+        c->path += c->step_motion;
+        c->step_motion = 0.0;
+        c->moving = memcmp(c->current, c->target, bytes) != 0;
+        /* at rest now: tight boxes again, and normals for good */
+        if (!c->moving) c->indexed = 0, c->normals_current = 0;
+    } else {
+        c->pose_current = c->pose_next;
+        c->moving = memcmp(&c->pose_current, &c->pose_target, sizeof c->pose_current) != 0;
+    }
+}

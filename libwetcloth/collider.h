@@ -7,7 +7,7 @@
 
 #include <stdint.h>
 
-#include "grid.h"
+#include "broadphase.h"
 #include "wetcloth.h"
 
 /// Position and orientation: x_world = position + rotate(rotation, x_local).
@@ -45,13 +45,6 @@ typedef struct wc_collider {
     int32_t edge_count;
     int32_t *edges;
     int32_t *triangle_edges;
-    /// Boxes of the vertices and edges over the step (current and next
-    /// positions) and their grids, for the feature pass (collide_features.c);
-    /// rebuilt with the triangle grid, so never for a static collider.
-    double *vertex_boxes;
-    double *edge_boxes;
-    wc_grid vertex_grid;
-    wc_grid edge_grid;
     /// Vertex positions now, xyz per vertex.
     double *current;
     /// Vertex positions at the end of the running advance.
@@ -60,22 +53,27 @@ typedef struct wc_collider {
     double *next;
     /// Whether target differs from current (the collider is animated now).
     int moving;
-    /// Box around the whole collider over the step (min xyz, max xyz).
+    /// Box around the whole collider over the running advance (min xyz,
+    /// max xyz); for a convex collider, over the step.
     double bounds[6];
-    /// Unit normal of each triangle at the start and at the end of the step
-    /// (zero for a degenerate triangle, which is then ignored).
-    double *normal_current;
-    double *normal_next;
-    /// Per triangle: its box over the step (current and next positions),
-    /// grown by the largest contact distance; the grid indexes them.
+    /// Per triangle: its box over the running advance (current and target
+    /// positions), and the tree over them (broadphase.h): built at the first
+    /// step, refit (not rebuilt) when the collider is given new vertices.
     double *boxes;
-    wc_grid grid;
-    /// The grid holds boxes of the current positions and needs no rebuild
-    /// while the collider does not move.
-    int grid_static;
-    /// Counts the builds of the grids, so what was made from them (the
-    /// feature pass' near lists) can tell they changed.
-    int64_t grid_version;
+    wc_bvh bvh;
+    /// Whether the boxes and the tree describe the running advance.
+    int indexed;
+    /// Unit normal of each triangle while the collider stands still (zero
+    /// for a degenerate triangle, which is then ignored), valid while
+    /// normals_current; a moving collider's are made where a test needs
+    /// them (narrowphase.c).
+    double *normals;
+    int normals_current;
+    /// The collider's path: summed over the committed steps, the largest
+    /// displacement of any of its vertices in each; and that displacement
+    /// in the step being computed. No vertex has moved farther than the
+    /// difference of two paths between them (candidates.h).
+    double path, step_motion;
 
     /* Convex colliders. */
     wc_convex_shape convex;
@@ -88,8 +86,9 @@ void wc_collider_destroy(wc_collider *collider);
 
 /// Readies a collider for a step that covers `share` of what is left of the
 /// running advance (1 / substeps left): next = current + (target - current)
-/// * share, its step boxes and, unless it is static and already indexed, its
-/// grid.
+/// * share and its step motion; at the first step of an advance that moves
+/// it (or the first step at all), its boxes over the advance and its tree
+/// (built once, refit after), and the normals of a static one.
 wc_status wc_collider_begin_step(wc_collider *collider, double share);
 
 /// After a step that was committed: the collider is now where it was headed.

@@ -71,6 +71,7 @@
 #include "grid.h"
 #include "parallel.h"
 #include "primitives.h"
+#include "response.h"
 #include "wetness.h"
 
 /* Response passes before the fail-safe. Each pass re-evaluates only what
@@ -1214,25 +1215,6 @@ static void relative(const double *x, const double *y, const double *z, const se
     }
 }
 
-/* The relative position the pair's velocity is measured from: each
- * particle's previous position as the next step will see it, which is the
- * start of the step unless a response already moved it (history_override:
- * a collider pass that pushed the particle out shifted it by the push).
- * Measured from the start of the step instead, such a push counted as
- * approach and came back as a velocity of push / dt: 0.35 mm at a step of
- * 8.6 us launched a particle at 40 m/s (the 101 x 101 drape's 8x reference). */
-static void step_start_relative(const wc_cloth *c, const self_contact *k, double out[3])
-{
-    out[0] = out[1] = out[2] = 0.0;
-    for (int j = 0; j < 4; ++j) {
-        int32_t i = k->p[j];
-        int shifted = c->history_override[i];
-        out[0] += k->w[j] * (shifted ? c->qx[i] : c->x[i]);
-        out[1] += k->w[j] * (shifted ? c->qy[i] : c->y[i]);
-        out[2] += k->w[j] * (shifted ? c->qz[i] : c->z[i]);
-    }
-}
-
 /* Orients n so that the start-of-step relative position is on its positive
  * side (the side each element was on), or, when the start gives no side,
  * so that the elements approach along it. */
@@ -1439,22 +1421,6 @@ static void evaluate(wc_self_state *s, const self_ctx *ctx, int ccd_only, int th
 /* Response                                                                 */
 /* ------------------------------------------------------------------------ */
 
-/* Answers one contact against the current state: moves nx (and q for the
- * part that must not become velocity), marks contacts. Returns whether any
- * particle moved. */
-/* Wetness of a pair in sustained contact: each side's wetness at the
- * contact point (barycentric over its particles that touched something in
- * the last step), the two sides averaged. 0 for dry cloth. */
-static double sustained_wetness(const wc_cloth *c, const self_contact *k)
-{
-    double wet = 0.0;
-    for (int j = 0; j < 4; ++j) {
-        int32_t i = k->p[j];
-        if (c->contact_prev[i] != WC_CONTACT_NONE) wet += 0.5 * fabs(k->w[j]) * c->wetness[i];
-    }
-    return wet;
-}
-
 /* Coulomb and wet friction of a pair (mu, q): the cloth's; between two
  * pieces the geometric mean of theirs, as a cloth meets a collider. */
 static void pair_friction(const wc_cloth *c, const wc_self_state *s, const self_contact *k,
@@ -1471,99 +1437,37 @@ static void pair_friction(const wc_cloth *c, const wc_self_state *s, const self_
     }
 }
 
+/* Answers one contact against the current state through the one response
+ * (response.h): an inelastic impulse that removes the approach along n, a
+ * position correction to the pair's target separation, Coulomb and wet
+ * friction. The target: h is the pair's thickness (pair_thickness); for a
+ * collision during the step min(start separation, h), so a pair never ends
+ * closer than it started unless it stays h apart, but at least a tenth of
+ * h (elements that start touching are parted a little, or the continuous
+ * test would find them again); a proximity's target is h. Returns whether
+ * any particle moved. */
 static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, const double friction[2],
                    double slack, int32_t *marked)
 {
-    double mu = friction[0];
-    double im[4], weight = 0.0;
-    if (dot3(k->n, k->n) == 0.0) return 0;
-    for (int j = 0; j < 4; ++j) {
-        int32_t i = k->p[j];
-        if (k->w[j] == 0.0) {
-            im[j] = 0.0;
-            continue;
-        }
-        double side = k->w[j] > 0.0 ? 1.0 : -1.0;
-        if (c->contact[i] == WC_CONTACT_NONE) {
-            c->contact[i] = WC_CONTACT_CLOTH;
-            c->normal_x[i] = side * k->n[0], c->normal_y[i] = side * k->n[1], c->normal_z[i] = side * k->n[2];
-            ++*marked;
-        }
-        im[j] = c->pin_slot[i] >= 0 ? 0.0 : c->inv_mass[i];
-        /* A particle resting on a collider must not be pushed into it: along
-         * that surface's normal it is as good as pinned. */
-        if (c->contact[i] == WC_CONTACT_COLLIDER) {
-            double nc[3] = {c->normal_x[i], c->normal_y[i], c->normal_z[i]};
-            if (side * dot3(k->n, nc) < 0.0) im[j] = 0.0;
-        }
-        weight += k->w[j] * k->w[j] * im[j];
-    }
-    if (!(weight > 0.0)) return 0;
-    double x0[3], x1[3], du[3];
-    step_start_relative(c, k, x0);
+    wc_contact ct;
+    memset(&ct, 0, sizeof ct);
+    ct.source = WC_SOURCE_CLOTH;
+    ct.impact = k->kind == COLLISION;
+    ct.count = 4;
+    for (int j = 0; j < 4; ++j) ct.particle[j] = k->p[j], ct.weight[j] = k->w[j];
+    for (int m = 0; m < 3; ++m) ct.normal[m] = k->n[m];
+    double x1[3];
     relative(c->nx, c->ny, c->nz, k, x1);
-    for (int m = 0; m < 3; ++m) du[m] = x1[m] - x0[m];
-    double un = dot3(du, k->n), sep = dot3(x1, k->n);
-    /* Inelastic: the approach along n is removed (dv, a change of velocity),
-     * then the end separation is set to the target (dp, a change of position
-     * only): the pair ends the step at the target, at rest relative to each
-     * other along n. h is the pair's thickness (pair_thickness). For a
-     * collision during the step the target is min(start separation, h), so
-     * a pair never ends closer than it started unless it stays h apart; a
-     * proximity's target is h. dp < 0 means the pair entered the band this
-     * step and settles onto it. */
-    double h = k->h, target = h;
-    if (k->kind == COLLISION) {
-        /* never closer than at the start (unless h apart), but at least a
-         * tenth of h: elements that start touching are parted a little, or
-         * the continuous test would find them again */
-        target = k->d0 > h ? h : k->d0 < 0.1 * h ? 0.1 * h : k->d0;
-    }
-    double dv = un < 0.0 ? -un : 0.0;
-    double dp = target - (sep + dv);
-    /* A collision whose normal motion already keeps the target cannot be
-     * answered along n: the fail-safe takes it. */
-    if (k->kind == COLLISION && !(sep < target)) return 0;
-    /* After the first pass, leftovers below the slack are not worth another
-     * pass (proximity only: a collision is always answered). */
-    if (k->kind == PROXIMITY && dv <= slack && fabs(dp) <= slack) return 0;
-    if (dv == 0.0 && dp <= 0.0) return 0;
-    /* Coulomb friction on the relative tangential motion: its change is at
-     * most mu times the normal change (tangential part of du is unchanged by
-     * the normal impulse). Wet layers in sustained contact also lose the
-     * share 1 - q of what Coulomb leaves (thesis eq. 2.10, as on colliders). */
-    double ft[3] = {0.0, 0.0, 0.0}, wet = c->wet_forces ? sustained_wetness(c, k) : 0.0;
-    if (dv > 0.0 && (mu > 0.0 || wet > 0.0)) {
-        double vt[3];
-        for (int m = 0; m < 3; ++m) vt[m] = du[m] - un * k->n[m];
-        double len = sqrt(dot3(vt, vt));
-        if (len > 0.0) {
-            double f = mu * dv / len;
-            if (f > 1.0) f = 1.0;
-            if (wet > 0.0) f = 1.0 - (1.0 - f) * (1.0 - wet * (1.0 - friction[1]));
-            for (int m = 0; m < 3; ++m) ft[m] = -f * vt[m];
-        }
-    }
-    for (int j = 0; j < 4; ++j) {
-        double scale = k->w[j] * im[j] / weight;
-        if (scale == 0.0) continue;
-        int32_t i = k->p[j];
-        double move = (dv + dp) * scale;
-        c->nx[i] += move * k->n[0] + scale * ft[0];
-        c->ny[i] += move * k->n[1] + scale * ft[1];
-        c->nz[i] += move * k->n[2] + scale * ft[2];
-        if (dp != 0.0) {
-            /* The position correction is not velocity: shift the previous
-             * position the next step sees by the same amount. */
-            if (!c->history_override[i]) {
-                c->qx[i] = c->x[i], c->qy[i] = c->y[i], c->qz[i] = c->z[i];
-                c->history_override[i] = 1;
-            }
-            double shift = dp * scale;
-            c->qx[i] += shift * k->n[0], c->qy[i] += shift * k->n[1], c->qz[i] += shift * k->n[2];
-        }
-        s->dirty[i] = 1;
-    }
+    ct.distance = dot3(x1, k->n);
+    double h = k->h;
+    ct.target = k->kind == COLLISION ? (k->d0 > h ? h : k->d0 < 0.1 * h ? 0.1 * h : k->d0) : h;
+    ct.friction = friction[0], ct.wet_friction = friction[1];
+    wc_particle_arrays p = wc_particle_arrays_of(c);
+    wc_response_options options = {slack};
+    uint8_t moved[4];
+    if (!wc_response_apply(&p, &ct, &options, marked, moved)) return 0;
+    for (int j = 0; j < 4; ++j)
+        if (moved[j]) s->dirty[k->p[j]] = 1;
     return 1;
 }
 

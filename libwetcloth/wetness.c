@@ -7,6 +7,7 @@
 #include "alloc.h"
 
 #include "convex.h"
+#include "grid.h"
 #include "parallel.h"
 #include "primitives.h"
 
@@ -232,7 +233,7 @@ void wc_wet_pair_adhesion(const int32_t *pairs, const double *data, int64_t coun
 
 /* Why a band. A particle resting on a faceted collider is placed at exactly
  * the contact distance r from the face under it, and then the feature pass
- * (collide_features.c) lifts the cloth triangles that lie over the
+ * (collider_contacts.c) lifts the cloth triangles that lie over the
  * collider's proud vertices and edges (6-11 mm proud on the thesis sphere)
  * to r from those, which lifts their corners 0.05-0.15 mm off the faces.
  * The next step's adhesion pulls such a particle back by less than that,
@@ -259,25 +260,29 @@ static int mesh_nearest(const wc_collider *col, const double p[3], double reach,
     for (int k = 0; k < 3; ++k) box[k] = p[k] - reach, box[k + 3] = p[k] + reach;
     if (!wc_boxes_overlap(box, col->bounds)) return 0;
     enum { CAPACITY = 256 };
-    int32_t found[CAPACITY];
-    int32_t count = wc_grid_query(&col->grid, box, found, CAPACITY);
-    int all = count > CAPACITY; /* a collider far finer than the reach: test them all */
-    int32_t total = all ? col->triangle_count : count;
+    int32_t stack[CAPACITY], *found = stack;
+    int32_t count = wc_bvh_query(&col->bvh, box, stack, CAPACITY);
+    if (count > CAPACITY) {
+        found = wc_alloc_array((size_t)count, sizeof *found);
+        if (!found) return 0; /* no room to look: the contact is not held */
+        wc_bvh_query(&col->bvh, box, found, count);
+    }
     double best = reach * reach, offset[3] = {0.0, 0.0, 0.0};
     int hit = 0;
-    for (int32_t k = 0; k < total; ++k) {
-        int32_t t = all ? k : found[k];
-        const double *n1 = col->normal_next + 3 * (size_t)t;
-        if (n1[0] == 0.0 && n1[1] == 0.0 && n1[2] == 0.0) continue; /* degenerate: ignored */
-        const int32_t *v = col->triangles + 3 * (size_t)t;
+    for (int32_t k = 0; k < count; ++k) {
+        const int32_t *v = col->triangles + 3 * (size_t)found[k];
         const double *a = col->next + 3 * (size_t)v[0], *b = col->next + 3 * (size_t)v[1],
                      *c = col->next + 3 * (size_t)v[2];
+        double nrm[3];
+        wc_triangle_normal(a, b, c, nrm);
+        if (nrm[0] == 0.0 && nrm[1] == 0.0 && nrm[2] == 0.0) continue; /* degenerate: ignored */
         double w[3];
         double d2 = wc_point_triangle_closest(p, a, b, c, w);
         if (!(d2 < best)) continue;
         best = d2, hit = 1;
         for (int j = 0; j < 3; ++j) offset[j] = p[j] - (w[0] * a[j] + w[1] * b[j] + w[2] * c[j]);
     }
+    if (found != stack) wc_free(found);
     double len = sqrt(best);
     if (!hit || !(len > 0.0)) return 0;
     for (int j = 0; j < 3; ++j) n[j] = offset[j] / len;

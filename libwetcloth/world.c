@@ -7,8 +7,7 @@
 #include "applied.h"
 #include "clock.h"
 #include "cloth_group.h"
-#include "collide.h"
-#include "collide_features.h"
+#include "collider_contacts.h"
 #include "forces.h"
 #include "implicit.h"
 #include "integrate.h"
@@ -186,8 +185,9 @@ static wc_status guard_steps(wc_world *w, double dt, int threads)
 
 /* Colliders move to where they are at the end of this step; each contact
  * then answers to the relative motion. `share` is the part of what is left
- * of the advance that this step covers. */
-static wc_status collide(wc_world *w, double dt, double share, int threads)
+ * of the advance that this step covers, `steps_left` how many steps of it
+ * follow this one. */
+static wc_status collide(wc_world *w, double dt, double share, int32_t steps_left, int threads)
 {
     for (int32_t k = 0; k < w->collider_count; ++k)
         if (wc_collider_begin_step(w->colliders[k], share))
@@ -201,33 +201,19 @@ static wc_status collide(wc_world *w, double dt, double share, int threads)
         memcpy(cl->contact_prev, cl->contact, (size_t)cl->particle_count);
         memset(cl->contact, 0, (size_t)cl->particle_count);
         memset(cl->history_override, 0, (size_t)cl->particle_count);
-        if (w->collider_count && !cl->features && !(cl->features = wc_feature_state_create(cl)))
+        if (!w->collider_count) continue;
+        if (!cl->collider_contacts && !(cl->collider_contacts = wc_collider_contacts_create(cl)))
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory for the collision buffers of cloth %d; the world "
                            "keeps its last good state", (int)c);
-        /* the paths the passes' clearances are measured against
-         * (near_list.h) start from this step's motion */
-        if (w->collider_count) wc_feature_state_begin_step(cl->features, cl);
-        /* Particles against collider faces, then collider vertices and edges
-         * against the cloth's triangles and edges; the second can push a
-         * particle back toward a face, so the two alternate until the
-         * second has nothing left to do. After the first round each looks
-         * only at what the other moved (collide.h). */
-        for (int round = 0; round < 3 && w->collider_count; ++round) {
-            wc_collide_cloth(cl, w->colliders, w->collider_count, dt, threads, round == 0,
-                             wc_feature_state_marks(cl->features), &w->stats);
-            int moved;
-            if (wc_collide_features(cl, cl->features, w->colliders, w->collider_count, dt,
-                                    round == 0, &w->stats, &moved))
-                return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
-                               "out of memory indexing cloth %d for collisions; the world keeps "
-                               "its last good state", (int)c);
-            if (!moved) break;
-        }
+        if (wc_collider_contacts_resolve(cl, cl->collider_contacts, w->colliders, w->collider_count,
+                                         steps_left, threads, &w->stats))
+            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                           "out of memory indexing cloth %d for collisions; the world keeps its "
+                           "last good state", (int)c);
         /* before self-collision, which must see held particles as resting
          * on their collider */
-        if (cl->wet_forces && w->collider_count)
-            wc_wet_hold_contacts(cl, w->colliders, w->collider_count, threads);
+        if (cl->wet_forces) wc_wet_hold_contacts(cl, w->colliders, w->collider_count, threads);
     }
     /* cloths against each other, after all their collider passes */
     if (wc_cloth_group_sync(&w->group, w->cloths, w->cloth_count) ||
@@ -294,8 +280,8 @@ static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_f
  * state is finite, so a failed step leaves the world exactly as it was.
  * The pins are at pin_start of the way to their targets when the step
  * starts and at pin_fraction when it ends. */
-static wc_status world_step(wc_world *w, double dt, double share, double pin_start,
-                            double pin_fraction)
+static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_left,
+                            double pin_start, double pin_fraction)
 {
     int threads = wc_thread_tuner_threads(&w->tuner);
     memset(&w->stats, 0, sizeof w->stats);
@@ -329,7 +315,7 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_sta
             return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory saving the contact state; the world keeps its last "
                            "good state");
-        s = collide(w, dt, share, threads);
+        s = collide(w, dt, share, steps_left, threads);
         if (s) {
             wc_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
             wc_cloth_group_restore(w->group);
@@ -356,11 +342,11 @@ static wc_status world_step(wc_world *w, double dt, double share, double pin_sta
 
 /* A step, timed for the thread tuner: the next step's thread count comes
  * from how long this one took on its count. */
-static wc_status timed_step(wc_world *w, double dt, double share, double pin_start,
-                            double pin_fraction)
+static wc_status timed_step(wc_world *w, double dt, double share, int32_t steps_left,
+                            double pin_start, double pin_fraction)
 {
     double start = wc_clock_seconds();
-    wc_status s = world_step(w, dt, share, pin_start, pin_fraction);
+    wc_status s = world_step(w, dt, share, steps_left, pin_start, pin_fraction);
     wc_thread_tuner_record(&w->tuner, wc_clock_seconds() - start);
     return s;
 }
@@ -422,7 +408,7 @@ wc_status wc_world_step(wc_world *w, double dt)
     wc_status s = check_step_length(w, "wc_world_step: dt", dt);
     if (s) return s;
     start_timing(w);
-    s = timed_step(w, dt, 1.0, 0.0, 1.0);
+    s = timed_step(w, dt, 1.0, 0, 0.0, 1.0);
     finish_timing(w);
     settle_pins(w, s ? 0.0 : 1.0);
     return s;
@@ -459,8 +445,8 @@ wc_status wc_world_advance(wc_world *w, double frame_dt, int32_t substeps)
     start_timing(w);
     int32_t done = 0; /* substeps that succeeded */
     while (done < substeps) {
-        s = timed_step(w, dt, 1.0 / (substeps - done), (double)done / substeps,
-                       (double)(done + 1) / substeps);
+        s = timed_step(w, dt, 1.0 / (substeps - done), substeps - done - 1,
+                       (double)done / substeps, (double)(done + 1) / substeps);
         if (s) break;
         ++done;
     }

@@ -9,7 +9,7 @@
 #include <time.h>
 
 #include "cloth.h"
-#include "collide_features.h"
+#include "collider_contacts.h"
 #include "primitives.h"
 #include "scenes.h"
 #include "test_util.h"
@@ -418,15 +418,15 @@ static void determinism(void)
     CHECK(h1 == h2 && h1 == h4, "hashes differ across thread counts");
 }
 
-/* The feature pass' near lists (near_list.h) only save grid queries: the
- * thesis scene with them and with a grid query every pass ends with the
- * same bits. One frame first, so the lists exist and are then reused for
- * 11 frames while the cloth falls and lands (at about 0.25 s). Verlet's
- * small steps keep a list for dozens of steps; XPBD at 20 steps per frame
- * moves the falling cloth out of its boxes every few steps, so its lists
- * are rebuilt often, each time only for the elements whose particles left
- * their boxes (the others keep their candidates and clearances). */
-static uint64_t thesis_hash(int keep_near_lists, wc_integrator integrator, int steps_per_frame,
+/* The candidates' filter (candidates.h) only skips pairs it proves cannot
+ * touch: the thesis scene with the filter and with every listed pair given
+ * the exact test ends with the same bits. One frame first, so the lists
+ * exist, then 11 frames while the cloth falls and lands (at about 0.25 s):
+ * Verlet's small steps keep a particle's lists for dozens of steps; XPBD
+ * at 20 steps per frame moves the falling cloth past its margins every few
+ * steps, so particles are rebased often. A wrong bound (a pair skipped that
+ * would have touched) changes the bits. */
+static uint64_t thesis_hash(int use_filter, wc_integrator integrator, int steps_per_frame,
                             int64_t *steps)
 {
     int32_t cl;
@@ -444,7 +444,7 @@ static uint64_t thesis_hash(int keep_near_lists, wc_integrator integrator, int s
     for (int f = 0; f < 12; ++f) {
         advance_or_fail(w, 1.0 / 24, steps_per_frame);
         *steps += wc_world_last_substeps(w);
-        if (f == 0) wc_feature_state_keep_near_lists(w->cloths[cl]->features, keep_near_lists);
+        if (f == 0) wc_collider_contacts_use_filter(w->cloths[cl]->collider_contacts, use_filter);
         contacts += wc_world_get_stats(w).collider_contacts;
     }
     CHECK(contacts > 0, "the cloth never reached the sphere");
@@ -453,15 +453,15 @@ static uint64_t thesis_hash(int keep_near_lists, wc_integrator integrator, int s
     return h;
 }
 
-static void near_lists(wc_integrator integrator, int steps_per_frame, const char *name)
+static void filter_is_exact(wc_integrator integrator, int steps_per_frame, const char *name)
 {
-    int64_t steps_kept, steps_asked;
-    uint64_t kept = thesis_hash(1, integrator, steps_per_frame, &steps_kept);
-    uint64_t asked = thesis_hash(0, integrator, steps_per_frame, &steps_asked);
-    printf("near lists (%s): thesis scene over 0.5 s, kept %016llx (%lld steps), grid every pass "
-           "%016llx (%lld steps)\n", name, (unsigned long long)kept, (long long)steps_kept,
-           (unsigned long long)asked, (long long)steps_asked);
-    CHECK(kept == asked, "the near lists changed the result (%s)", name);
+    int64_t steps_filtered, steps_all;
+    uint64_t filtered = thesis_hash(1, integrator, steps_per_frame, &steps_filtered);
+    uint64_t all = thesis_hash(0, integrator, steps_per_frame, &steps_all);
+    printf("filter (%s): thesis scene over 0.5 s, filtered %016llx (%lld steps), every listed "
+           "pair tested %016llx (%lld steps)\n", name, (unsigned long long)filtered,
+           (long long)steps_filtered, (unsigned long long)all, (long long)steps_all);
+    CHECK(filtered == all, "the filter changed the result (%s)", name);
 }
 
 static double seconds(void)
@@ -488,8 +488,8 @@ int main(void)
     printf("(%.1f s) ", seconds() - t0);
     determinism();
     printf("(%.1f s) ", seconds() - t0);
-    near_lists(WC_INTEGRATOR_VERLET, 0, "verlet");
-    near_lists(WC_INTEGRATOR_XPBD, 20, "xpbd, 20 steps per frame");
+    filter_is_exact(WC_INTEGRATOR_VERLET, 0, "verlet");
+    filter_is_exact(WC_INTEGRATOR_XPBD, 20, "xpbd, 20 steps per frame");
     printf("(%.1f s)\n", seconds() - t0);
     return test_report("test_collide");
 }

@@ -1,11 +1,13 @@
-/* The broadphase grid (grid.c): on randomised scenes, every query returns
- * exactly the items a brute-force scan finds (ascending, no duplicates),
- * including items far larger than a cell, queries larger than the grid
- * allows cell by cell, and boxes that merely touch. */
+/* The broadphase grid (grid.c) and the colliders' tree (broadphase.c): on
+ * randomised scenes, every query returns exactly the items a brute-force
+ * scan finds (ascending, no duplicates), including items far larger than a
+ * cell, queries larger than the grid allows cell by cell, and boxes that
+ * merely touch; the tree also after its boxes moved and it was refit. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "broadphase.h"
 #include "grid.h"
 #include "test_util.h"
 
@@ -85,9 +87,62 @@ static void huge_boxes(void)
     wc_grid_free(&g);
 }
 
+/* The tree over n boxes: queries against brute force, then the boxes
+ * moved far (a deforming collider) and the tree refit, queries again. */
+static void tree(int32_t n, double item_size, double query_size, int queries)
+{
+    double *boxes = malloc(6 * sizeof(double) * (size_t)n);
+    int32_t *found = malloc(sizeof(int32_t) * (size_t)n), *expect = malloc(sizeof(int32_t) * (size_t)n);
+    for (int32_t i = 0; i < n; ++i) random_box(boxes + 6 * i, 1.0, item_size);
+    wc_bvh b;
+    wc_bvh_init(&b);
+    CHECK(wc_bvh_build(&b, boxes, n) == WC_OK, "tree build failed");
+    int mismatches = 0;
+    long total = 0;
+    for (int round = 0; round < 2; ++round) {
+        if (round == 1) {
+            /* every box moves by up to half the scene: the shape stays, the
+             * answers must not change from brute force */
+            for (int32_t i = 0; i < n; ++i) {
+                double shift[3] = {uniform(-0.5, 0.5), uniform(-0.5, 0.5), uniform(-0.5, 0.5)};
+                for (int k = 0; k < 3; ++k) boxes[6 * i + k] += shift[k], boxes[6 * i + k + 3] += shift[k];
+            }
+            wc_bvh_refit(&b);
+        }
+        for (int q = 0; q < queries; ++q) {
+            double box[6];
+            random_box(box, 1.2, query_size);
+            int32_t got = wc_bvh_query(&b, box, found, n), want = 0;
+            for (int32_t i = 0; i < n; ++i)
+                if (wc_boxes_overlap(box, boxes + 6 * i)) expect[want++] = i;
+            total += want;
+            if (got != want) {
+                ++mismatches;
+                continue;
+            }
+            for (int32_t k = 0; k < got; ++k)
+                if (found[k] != expect[k]) {
+                    ++mismatches;
+                    break;
+                }
+        }
+    }
+    /* a full buffer: the count without overrun */
+    double all[6] = {-10, -10, -10, 10, 10, 10};
+    CHECK(wc_bvh_query(&b, all, found, 1) == n, "a query with a small buffer must still count all");
+    printf("tree: %d items, %d queries twice (after a refit), %ld hits, %d mismatches\n", (int)n,
+           queries, total, mismatches);
+    CHECK(mismatches == 0, "tree queries differ from brute force");
+    wc_bvh_free(&b);
+    free(boxes), free(found), free(expect);
+}
+
 int main(void)
 {
     huge_boxes();
+    tree(3000, 0.02, 0.1, 2000);
+    tree(7, 0.3, 0.5, 200);
+    tree(1, 0.1, 0.5, 100);
     scene(2000, 0.02, 0.05, 0.05, 3000);  /* cloth-like: small items, small queries */
     scene(500, 0.1, 0.02, 0.1, 2000);     /* items spanning many cells (the large list) */
     scene(3000, 0.01, 0.03, 1.5, 40);     /* queries spanning the whole grid (the scan) */

@@ -1,0 +1,211 @@
+#include "broadphase.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+
+/* Deeper than a median-split tree over 2^27 items can get (27 levels). */
+#define STACK_DEPTH 96
+
+void wc_bvh_init(wc_bvh *b) { memset(b, 0, sizeof *b); }
+
+void wc_bvh_free(wc_bvh *b)
+{
+    wc_free(b->nodes);
+    wc_free(b->order);
+    wc_bvh_init(b);
+}
+
+static void empty_box(double box[6])
+{
+    for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
+}
+
+/* Plain comparisons: a NaN bound leaves the box as it was. */
+static void union_box(double box[6], const double add[6])
+{
+    for (int k = 0; k < 3; ++k) {
+        if (add[k] < box[k]) box[k] = add[k];
+        if (add[k + 3] > box[k + 3]) box[k + 3] = add[k + 3];
+    }
+}
+
+/* Twice the centre of item i along an axis; NaN sorts last. */
+static double key(const double *boxes, int32_t i, int axis)
+{
+    double k = boxes[6 * (size_t)i + axis] + boxes[6 * (size_t)i + axis + 3];
+    return k == k ? k : INFINITY;
+}
+
+static int before(const double *boxes, int32_t a, int32_t b, int axis)
+{
+    double ka = key(boxes, a, axis), kb = key(boxes, b, axis);
+    return ka < kb || (ka == kb && a < b);
+}
+
+/* Reorders items[0 .. n) so that items[m] is the one a full sort would put
+ * there, smaller ones before it and larger after (quickselect, middle
+ * pivot; deterministic). */
+static void select_median(const double *boxes, int32_t *items, int32_t n, int32_t m, int axis)
+{
+    int32_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int32_t pivot = items[lo + (hi - lo) / 2], i = lo, j = hi;
+        while (i <= j) {
+            while (before(boxes, items[i], pivot, axis)) ++i;
+            while (before(boxes, pivot, items[j], axis)) --j;
+            if (i <= j) {
+                int32_t t = items[i];
+                items[i] = items[j], items[j] = t;
+                ++i, --j;
+            }
+        }
+        if (m <= j) hi = j;
+        else if (m >= i) lo = i;
+        else return;
+    }
+}
+
+/* Box of items[0 .. n) and the axis along which their centres spread most. */
+static int split_axis(const double *boxes, const int32_t *items, int32_t n, double box[6])
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    empty_box(box);
+    for (int32_t k = 0; k < n; ++k) {
+        union_box(box, boxes + 6 * (size_t)items[k]);
+        for (int a = 0; a < 3; ++a) {
+            double c = key(boxes, items[k], a);
+            if (c == INFINITY) continue;
+            if (c < lo[a]) lo[a] = c;
+            if (c > hi[a]) hi[a] = c;
+        }
+    }
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+        if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    return axis;
+}
+
+wc_status wc_bvh_build(wc_bvh *b, const double *boxes, int32_t count)
+{
+    wc_bvh_free(b);
+    b->boxes = boxes;
+    if (count <= 0) return WC_OK;
+    b->order = wc_alloc_array((size_t)count, sizeof *b->order);
+    b->nodes = wc_alloc_array(2 * (size_t)count, sizeof *b->nodes);
+    if (!b->order || !b->nodes) {
+        wc_bvh_free(b);
+        return WC_ERROR_OUT_OF_MEMORY;
+    }
+    b->item_count = count;
+    for (int32_t i = 0; i < count; ++i) b->order[i] = i;
+    /* Top-down: a node holds a run of `order`; one with more than a leaf's
+     * worth is split at the median of its centres along its widest axis,
+     * its children taking the two halves (allocated as a pair, after it:
+     * refit relies on children coming after their parent). */
+    int32_t stack[STACK_DEPTH], depth = 0;
+    b->nodes[0].first = 0, b->nodes[0].count = count;
+    b->node_count = 1;
+    stack[depth++] = 0;
+    while (depth > 0) {
+        wc_bvh_node *node = b->nodes + stack[--depth];
+        int32_t first = node->first, n = node->count;
+        int axis = split_axis(boxes, b->order + first, n, node->box);
+        if (n <= WC_BVH_LEAF || depth + 2 > STACK_DEPTH) continue;
+        int32_t half = n / 2;
+        select_median(boxes, b->order + first, n, half, axis);
+        int32_t left = b->node_count;
+        b->node_count += 2;
+        b->nodes[left].first = first, b->nodes[left].count = half;
+        b->nodes[left + 1].first = first + half, b->nodes[left + 1].count = n - half;
+        node->first = left, node->count = 0;
+        stack[depth++] = left + 1;
+        stack[depth++] = left;
+    }
+    return WC_OK;
+}
+
+void wc_bvh_refit(wc_bvh *b)
+{
+    for (int32_t k = b->node_count - 1; k >= 0; --k) {
+        wc_bvh_node *node = b->nodes + k;
+        empty_box(node->box);
+        if (node->count == 0) {
+            union_box(node->box, b->nodes[node->first].box);
+            union_box(node->box, b->nodes[node->first + 1].box);
+        } else {
+            for (int32_t j = 0; j < node->count; ++j)
+                union_box(node->box, b->boxes + 6 * (size_t)b->order[node->first + j]);
+        }
+    }
+}
+
+static int overlap(const double a[6], const double b[6])
+{
+    return a[0] <= b[3] && b[0] <= a[3] && a[1] <= b[4] && b[1] <= a[4] && a[2] <= b[5] &&
+           b[2] <= a[5];
+}
+
+static int compare_int32(const void *pa, const void *pb)
+{
+    int32_t a = *(const int32_t *)pa, b = *(const int32_t *)pb;
+    return a < b ? -1 : a > b;
+}
+
+static void sort_items(int32_t *items, int32_t n)
+{
+    if (n > 24) {
+        qsort(items, (size_t)n, sizeof *items, compare_int32);
+        return;
+    }
+    for (int32_t i = 1; i < n; ++i) {
+        int32_t v = items[i], j = i;
+        for (; j > 0 && items[j - 1] > v; --j) items[j] = items[j - 1];
+        items[j] = v;
+    }
+}
+
+int32_t wc_bvh_collect(const wc_bvh *b, const double box[6], int32_t *out, int32_t capacity)
+{
+    if (b->node_count == 0) return 0;
+    int32_t stack[STACK_DEPTH], depth = 0, found = 0;
+    stack[depth++] = 0;
+    while (depth > 0) {
+        const wc_bvh_node *node = b->nodes + stack[--depth];
+        if (!overlap(node->box, box)) continue;
+        if (node->count == 0) {
+            stack[depth++] = node->first + 1;
+            stack[depth++] = node->first;
+            continue;
+        }
+        for (int32_t j = 0; j < node->count; ++j) {
+            int32_t item = b->order[node->first + j];
+            if (!overlap(b->boxes + 6 * (size_t)item, box)) continue;
+            if (found < capacity) out[found] = item;
+            ++found;
+        }
+    }
+    return found;
+}
+
+int32_t wc_bvh_query(const wc_bvh *b, const double box[6], int32_t *out, int32_t capacity)
+{
+    int32_t found = wc_bvh_collect(b, box, out, capacity);
+    /* only a complete answer is sorted; the caller asks again with room */
+    if (found <= capacity) sort_items(out, found);
+    return found;
+}
+
+double wc_bvh_root_distance(const wc_bvh *b, const double p[3])
+{
+    if (b->node_count == 0) return INFINITY;
+    const double *box = b->nodes[0].box;
+    double g2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        double g = box[k] - p[k] > p[k] - box[k + 3] ? box[k] - p[k] : p[k] - box[k + 3];
+        if (g > 0.0) g2 += g * g;
+    }
+    return sqrt(g2);
+}

@@ -1,0 +1,70 @@
+/* Broadphase: a bounding volume hierarchy over axis-aligned boxes (a
+ * collider's triangles). Built once from the boxes, top-down by median
+ * splits of the box centres; when the boxes change (a deforming collider)
+ * it is refit, not rebuilt: the tree keeps its shape and every node's box
+ * becomes the union of its children's again. A refit tree stays correct
+ * however far the items move (only its culling gets looser), so a collider
+ * whose vertices are animated pays one pass over its triangles per frame,
+ * not a rebuild per substep.
+ *
+ * Why a tree and not a grid sized by one cell: a query's cost should follow
+ * what it finds. A uniform grid sized by the triangles visits every cell of
+ * a query box, and a query box as large as the contact distance (0.02 m, a
+ * few mm of cloth thickness) around a collider of 1 cm triangles is a
+ * hundred cells; the tree visits only nodes whose boxes meet it.
+ *
+ * Building is serial and deterministic (ties by item index); queries only
+ * read, and return the items in ascending order, so results do not depend on
+ * the thread count or on the tree's shape. */
+#ifndef WC_BROADPHASE_H
+#define WC_BROADPHASE_H
+
+#include <stdint.h>
+
+#include "wetcloth.h"
+
+/// Items per leaf at most.
+#define WC_BVH_LEAF 4
+
+typedef struct wc_bvh_node {
+    double box[6];
+    /// Internal node: its children are nodes `first` and `first + 1`
+    /// (count 0). Leaf: items order[first .. first + count).
+    int32_t first;
+    int32_t count;
+} wc_bvh_node;
+
+typedef struct wc_bvh {
+    int32_t item_count;
+    int32_t node_count;
+    wc_bvh_node *nodes;
+    /// Items in leaf order.
+    int32_t *order;
+    /// The item boxes (6 doubles each: min xyz, max xyz), kept by pointer:
+    /// they must outlive the queries and be current when refit is called.
+    const double *boxes;
+} wc_bvh;
+
+void wc_bvh_init(wc_bvh *bvh);
+void wc_bvh_free(wc_bvh *bvh);
+
+/// Builds the tree over `count` boxes. Non-finite boxes are allowed (they
+/// meet no query). WC_ERROR_OUT_OF_MEMORY on failure (the tree is then empty).
+wc_status wc_bvh_build(wc_bvh *bvh, const double *boxes, int32_t count);
+
+/// After the boxes changed in place: every node's box made from them again.
+void wc_bvh_refit(wc_bvh *bvh);
+
+/// Items whose boxes overlap `box` (touching counts), ascending, into out (up
+/// to capacity); returns how many there are (which may exceed capacity).
+int32_t wc_bvh_query(const wc_bvh *bvh, const double box[6], int32_t *out, int32_t capacity);
+
+/// The same, in the tree's order (not sorted): for callers that sort what
+/// they keep of it themselves.
+int32_t wc_bvh_collect(const wc_bvh *bvh, const double box[6], int32_t *out, int32_t capacity);
+
+/// Distance from point p to the tree's root box (0 inside it; +inf for an
+/// empty tree): no item is nearer.
+double wc_bvh_root_distance(const wc_bvh *bvh, const double p[3]);
+
+#endif

@@ -1,0 +1,454 @@
+#include "candidates.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "primitives.h"
+
+/* Margins, as fractions of the contact distance r: never less than LOW
+ * (a resting cloth: its lists last as long as it rests), and no more than
+ * HIGH unless the particle's motion in this step needs more (a larger
+ * margin lists more pairs: on a collider of 1 cm triangles a margin of 2 r =
+ * 5 cm lists some 300 triangles per particle). */
+#define MARGIN_LOW 0.25
+#define MARGIN_HIGH 0.5
+/* A margin covers this many times the motion expected until the frame ends. */
+#define MARGIN_AHEAD 1.5
+
+void wc_candidates_init(wc_candidates *c) { memset(c, 0, sizeof *c); }
+
+static void lists_free(wc_pair_lists *l)
+{
+    wc_free(l->start), wc_free(l->count), wc_free(l->room), wc_free(l->path_at);
+    wc_free(l->least), wc_free(l->snap), wc_free(l->item), wc_free(l->d);
+    memset(l, 0, sizeof *l);
+}
+
+void wc_candidates_free(wc_candidates *c)
+{
+    wc_free(c->base), wc_free(c->margin), wc_free(c->base_path), wc_free(c->base_length);
+    lists_free(&c->particles), lists_free(&c->triangles), lists_free(&c->edges);
+    wc_free(c->vertex_seen), wc_free(c->edge_seen), wc_free(c->found), wc_free(c->gathered), wc_free(c->gathered_d0);
+    wc_candidates_init(c);
+}
+
+static int lists_init(wc_pair_lists *l, int32_t owners, int per)
+{
+    lists_free(l);
+    size_t n = owners > 0 ? (size_t)owners : 1;
+    l->owner_count = owners;
+    l->per = per;
+    l->start = wc_alloc_array(n, sizeof *l->start);
+    l->count = wc_alloc_array(n, sizeof *l->count);
+    l->room = wc_alloc_array(n, sizeof *l->room);
+    l->path_at = wc_alloc_array(n, sizeof *l->path_at);
+    l->least = wc_alloc_array(n, sizeof *l->least);
+    l->snap = wc_alloc_array(n * (size_t)(per > 0 ? per : 1), sizeof *l->snap);
+    return l->start && l->count && l->room && l->path_at && l->least && l->snap;
+}
+
+/* Moves every list to the front of a pool of `capacity`, in owner order,
+ * dropping the garbage. */
+static int lists_repack(wc_pair_lists *l, int64_t capacity)
+{
+    int32_t *item = wc_alloc_array((size_t)capacity, sizeof *item);
+    double *d = wc_alloc_array((size_t)capacity, sizeof *d);
+    if (!item || !d) {
+        wc_free(item), wc_free(d);
+        return 0;
+    }
+    int64_t at = 0;
+    for (int32_t k = 0; k < l->owner_count; ++k) {
+        if (l->count[k]) {
+            memcpy(item + at, l->item + l->start[k], (size_t)l->count[k] * sizeof *item);
+            memcpy(d + at, l->d + l->start[k], (size_t)l->count[k] * sizeof *d);
+        }
+        l->start[k] = (int32_t)at;
+        l->room[k] = l->count[k];
+        at += l->count[k];
+    }
+    wc_free(l->item), wc_free(l->d);
+    l->item = item, l->d = d;
+    l->used = at, l->capacity = capacity, l->garbage = 0;
+    return 1;
+}
+
+/* Owner k's list becomes items/d0[0 .. n) (sorted by the caller), its
+ * snapshot the collider's path and the owner's particles' path lengths at
+ * their bases. */
+static int lists_put(wc_pair_lists *l, int32_t k, const int32_t *items, const double *d0, int32_t n,
+                     double path, const double *snap)
+{
+    l->path_at[k] = path;
+    double least = INFINITY;
+    for (int32_t j = 0; j < n; ++j)
+        if (d0[j] < least) least = d0[j];
+    l->least[k] = least;
+    for (int j = 0; j < l->per; ++j) l->snap[(size_t)l->per * (size_t)k + (size_t)j] = snap[j];
+    if (n > l->room[k]) {
+        l->garbage += l->room[k];
+        l->room[k] = 0, l->count[k] = 0;
+        int64_t room = n + n / 2 + 2;
+        if (l->used + room > l->capacity) {
+            int64_t live = l->used - l->garbage, need = live + room, cap = 2 * need;
+            if (cap < 1024) cap = 1024;
+            if (cap > INT32_MAX) cap = need;
+            if (need > INT32_MAX || !lists_repack(l, cap)) return 0;
+        }
+        l->start[k] = (int32_t)l->used;
+        l->room[k] = (int32_t)room;
+        l->used += room;
+    }
+    if (n) {
+        memcpy(l->item + l->start[k], items, (size_t)n * sizeof *items);
+        memcpy(l->d + l->start[k], d0, (size_t)n * sizeof *d0);
+    }
+    l->count[k] = n;
+    return 1;
+}
+
+static void vertex_of(const double *xyz, int32_t v, double out[3])
+{
+    out[0] = xyz[3 * (size_t)v], out[1] = xyz[3 * (size_t)v + 1], out[2] = xyz[3 * (size_t)v + 2];
+}
+
+double wc_candidates_particle_distance(const wc_collider *col, int32_t t, const double p[3])
+{
+    const int32_t *v = col->triangles + 3 * (size_t)t;
+    double a[3], b[3], c[3], w[3];
+    vertex_of(col->current, v[0], a), vertex_of(col->current, v[1], b), vertex_of(col->current, v[2], c);
+    return sqrt(wc_point_triangle_closest(p, a, b, c, w));
+}
+
+/* Collider triangles whose boxes meet `box`, into c->found (grown as
+ * needed). -1 on out-of-memory. */
+static int32_t query(wc_candidates *c, const wc_bvh *bvh, const double box[6])
+{
+    int32_t n = wc_bvh_collect(bvh, box, c->found, c->found_capacity);
+    if (n <= c->found_capacity) return n;
+    int32_t *grown = wc_alloc_array((size_t)n, 2 * sizeof *grown);
+    if (!grown) return -1;
+    wc_free(c->found);
+    c->found = grown, c->found_capacity = 2 * n;
+    return wc_bvh_collect(bvh, box, c->found, c->found_capacity);
+}
+
+/* Scratch for one owner's pairs: `n` ids and distances. */
+typedef struct pair_entry {
+    double d0;
+    int32_t item;
+} pair_entry;
+
+static int compare_entries(const void *pa, const void *pb)
+{
+    const pair_entry *a = pa, *b = pb;
+    return a->item < b->item ? -1 : a->item > b->item;
+}
+
+/* The owner's kept pairs, ascending by item (the order the tests take
+ * them in), into lists l. */
+static int keep_sorted(wc_candidates *c, wc_pair_lists *l, int32_t owner, pair_entry *e, int32_t n,
+                       double path, const double *snap)
+{
+    if (n > 32) {
+        qsort(e, (size_t)n, sizeof *e, compare_entries);
+    } else {
+        for (int32_t i = 1; i < n; ++i) {
+            pair_entry v = e[i];
+            int32_t j = i;
+            for (; j > 0 && e[j - 1].item > v.item; --j) e[j] = e[j - 1];
+            e[j] = v;
+        }
+    }
+    int32_t *ids = c->gathered;
+    double *d0 = c->gathered_d0;
+    for (int32_t k = 0; k < n; ++k) ids[k] = e[k].item, d0[k] = e[k].d0;
+    return lists_put(l, owner, ids, d0, n, path, snap);
+}
+
+/* Scratch of at least n entries (and n gathered ids). */
+static pair_entry *entries(wc_candidates *c, int64_t n, pair_entry **buf, int64_t *cap)
+{
+    if (*buf && n <= *cap && n <= c->gathered_capacity) return *buf;
+    int64_t want = 2 * n + 64;
+    pair_entry *e = wc_alloc_array((size_t)want, sizeof *e);
+    int32_t *g = wc_alloc_array((size_t)want, sizeof *g);
+    double *d = wc_alloc_array((size_t)want, sizeof *d);
+    if (!e || !g || !d) {
+        wc_free(e), wc_free(g), wc_free(d);
+        return NULL;
+    }
+    wc_free(*buf), wc_free(c->gathered), wc_free(c->gathered_d0);
+    *buf = e, *cap = want;
+    c->gathered = g, c->gathered_d0 = d, c->gathered_capacity = want;
+    return e;
+}
+
+typedef struct scratch {
+    pair_entry *e;
+    int64_t cap;
+} scratch;
+
+static void base_of(const wc_candidates *c, int32_t i, double out[3]) { vertex_of(c->base, i, out); }
+
+static double element_margin(const wc_candidates *c, const int32_t *idx, int count)
+{
+    double m = 0.0;
+    for (int k = 0; k < count; ++k)
+        if (c->margin[idx[k]] > m) m = c->margin[idx[k]];
+    return m;
+}
+
+static void element_box(const wc_candidates *c, const int32_t *idx, int count, double grow, double box[6])
+{
+    for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
+    for (int j = 0; j < count; ++j) {
+        double p[3];
+        base_of(c, idx[j], p);
+        for (int k = 0; k < 3; ++k) {
+            if (p[k] - grow < box[k]) box[k] = p[k] - grow;
+            if (p[k] + grow > box[k + 3]) box[k + 3] = p[k] + grow;
+        }
+    }
+}
+
+/* Particle i's list: collider triangles within r + margin of its base. */
+static int particle_list(wc_candidates *c, scratch *s, const wc_collider *col, const wc_bvh *bvh, int32_t i)
+{
+    double p[3], reach = c->r + c->margin[i], box[6];
+    base_of(c, i, p);
+    for (int k = 0; k < 3; ++k) box[k] = p[k] - reach, box[k + 3] = p[k] + reach;
+    int32_t n = query(c, bvh, box);
+    if (n < 0) return 0;
+    pair_entry *e = entries(c, n, &s->e, &s->cap);
+    if (!e) return 0;
+    int32_t kept = 0;
+    for (int32_t k = 0; k < n; ++k) {
+        double d = wc_candidates_particle_distance(col, c->found[k], p);
+        if (d <= reach) e[kept].d0 = d, e[kept].item = c->found[k], ++kept;
+    }
+    return keep_sorted(c, &c->particles, i, e, kept, c->base_path[i], c->base_length + i);
+}
+
+/* Cloth triangle t's list: collider vertices within r + M of it (its
+ * corners at their bases), found through the collider triangles near it. */
+static int triangle_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, const wc_collider *col,
+                         const wc_bvh *bvh, int32_t t, double path)
+{
+    const int32_t *idx = el->triangles + 3 * (size_t)t;
+    double reach = c->r + element_margin(c, idx, 3), box[6], a[3], b[3], d[3];
+    element_box(c, idx, 3, reach, box);
+    int32_t n = query(c, bvh, box);
+    if (n < 0) return 0;
+    pair_entry *e = entries(c, 3 * (int64_t)n, &s->e, &s->cap);
+    if (!e) return 0;
+    base_of(c, idx[0], a), base_of(c, idx[1], b), base_of(c, idx[2], d);
+    int32_t kept = 0, seen = 0;
+    for (int32_t k = 0; k < n; ++k)
+        for (int j = 0; j < 3; ++j) {
+            int32_t v = col->triangles[3 * (size_t)c->found[k] + j];
+            if (c->vertex_seen[v]) continue;
+            c->vertex_seen[v] = 1;
+            c->gathered[seen++] = v;
+            double p[3], w[3];
+            vertex_of(col->current, v, p);
+            double dist = sqrt(wc_point_triangle_closest(p, a, b, d, w));
+            if (dist <= reach) e[kept].d0 = dist, e[kept].item = v, ++kept;
+        }
+    for (int32_t k = 0; k < seen; ++k) c->vertex_seen[c->gathered[k]] = 0;
+    double snap[3] = {c->base_length[idx[0]], c->base_length[idx[1]], c->base_length[idx[2]]};
+    return keep_sorted(c, &c->triangles, t, e, kept, path, snap);
+}
+
+/* A lower bound on the distance between segments p-q and a-b: from the
+ * midpoint of p-q to a-b, less half the length of p-q. */
+static double segment_lower_bound(const double p[3], const double q[3], const double a[3],
+                                  const double b[3])
+{
+    double m[3], ab[3], am[3], half2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        m[k] = 0.5 * (p[k] + q[k]);
+        ab[k] = b[k] - a[k], am[k] = m[k] - a[k];
+        half2 += 0.25 * (q[k] - p[k]) * (q[k] - p[k]);
+    }
+    double len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    double t = len2 > 0.0 ? (am[0] * ab[0] + am[1] * ab[1] + am[2] * ab[2]) / len2 : 0.0;
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    double d2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        double g = am[k] - t * ab[k];
+        d2 += g * g;
+    }
+    return sqrt(d2) - sqrt(half2);
+}
+
+/* Cloth edge e's list: collider edges within r + M of it. */
+static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, const wc_collider *col,
+                     const wc_bvh *bvh, int32_t edge, double path)
+{
+    const int32_t *idx = el->edges + 2 * (size_t)edge;
+    double reach = c->r + element_margin(c, idx, 2), box[6], a[3], b[3];
+    element_box(c, idx, 2, reach, box);
+    int32_t n = query(c, bvh, box);
+    if (n < 0) return 0;
+    pair_entry *e = entries(c, 3 * (int64_t)n, &s->e, &s->cap);
+    if (!e) return 0;
+    base_of(c, idx[0], a), base_of(c, idx[1], b);
+    int32_t kept = 0, seen = 0;
+    for (int32_t k = 0; k < n; ++k)
+        for (int j = 0; j < 3; ++j) {
+            int32_t f = col->triangle_edges[3 * (size_t)c->found[k] + j];
+            if (f < 0 || c->edge_seen[f]) continue;
+            c->edge_seen[f] = 1;
+            c->gathered[seen++] = f;
+            double p[3], q[3], u, v;
+            vertex_of(col->current, col->edges[2 * (size_t)f], p);
+            vertex_of(col->current, col->edges[2 * (size_t)f + 1], q);
+            /* cheap bound first: no point of the collider edge is nearer to
+             * the cloth edge than its midpoint's distance less half its
+             * length */
+            if (segment_lower_bound(p, q, a, b) > reach) continue;
+            double dist = sqrt(wc_segment_segment_closest(p, q, a, b, &u, &v));
+            if (dist <= reach) e[kept].d0 = dist, e[kept].item = f, ++kept;
+        }
+    for (int32_t k = 0; k < seen; ++k) c->edge_seen[c->gathered[k]] = 0;
+    double snap[2] = {c->base_length[idx[0]], c->base_length[idx[1]]};
+    return keep_sorted(c, &c->edges, edge, e, kept, path, snap);
+}
+
+/* New base (the start of the step) and margin for particle i. Its margin
+ * must cover this step at once (its motion and the collider's), and is made
+ * to cover MARGIN_AHEAD times the motion expected until the frame ends,
+ * within [MARGIN_LOW r, MARGIN_HIGH r]; a particle farther than that from
+ * the collider's box gets the whole gap, which nothing can be nearer than. */
+double wc_candidates_displacement(const wc_candidates *c, const wc_particle_arrays *p, int32_t i)
+{
+    const double *b = c->base + 3 * (size_t)i;
+    double s[3] = {p->x[i] - b[0], p->y[i] - b[1], p->z[i] - b[2]};
+    double e[3] = {p->nx[i] - b[0], p->ny[i] - b[1], p->nz[i] - b[2]};
+    double s2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2], e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+    return sqrt(s2 > e2 ? s2 : e2);
+}
+
+static void rebase_one(wc_candidates *c, const wc_collider *col, const wc_bvh *bvh, int32_t i,
+                       const wc_particle_arrays *pa, const wc_particle_paths *paths,
+                       int32_t steps_left)
+{
+    double p[3] = {pa->x[i], pa->y[i], pa->z[i]}, r = c->r;
+    double d[3] = {pa->nx[i] - p[0], pa->ny[i] - p[1], pa->nz[i] - p[2]};
+    double now = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + col->step_motion;
+    double m = MARGIN_AHEAD * now * (1.0 + (steps_left > 0 ? steps_left : 0));
+    if (m < MARGIN_LOW * r) m = MARGIN_LOW * r;
+    if (m > MARGIN_HIGH * r) m = MARGIN_HIGH * r;
+    if (m < MARGIN_AHEAD * now) m = MARGIN_AHEAD * now;
+    /* strictly above this step's own motion, even when it is zero */
+    if (!(m > now)) m = now + MARGIN_LOW * r + 1e-12;
+    double gap = wc_bvh_root_distance(bvh, p) - r;
+    if (gap > m && isfinite(gap)) m = gap;
+    c->base[3 * (size_t)i] = p[0], c->base[3 * (size_t)i + 1] = p[1], c->base[3 * (size_t)i + 2] = p[2];
+    c->margin[i] = m;
+    c->base_path[i] = col->path;
+    c->base_length[i] = paths->path_start[i];
+}
+
+static int allocate(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col)
+{
+    size_t n = el->particle_count > 0 ? (size_t)el->particle_count : 1;
+    /* each made once; a failed call leaves the others for the retry */
+    if (!c->base) c->base = wc_alloc_array(3 * n, sizeof *c->base);
+    if (!c->margin) c->margin = wc_alloc_array(n, sizeof *c->margin);
+    if (!c->base_path) c->base_path = wc_alloc_array(n, sizeof *c->base_path);
+    if (!c->base_length) c->base_length = wc_alloc_array(n, sizeof *c->base_length);
+    if (!c->vertex_seen) c->vertex_seen = wc_alloc_array((size_t)col->vertex_count, 1);
+    if (!c->edge_seen) c->edge_seen = wc_alloc_array((size_t)col->edge_count + 1, 1);
+    return c->base && c->margin && c->base_path && c->base_length && c->vertex_seen && c->edge_seen;
+}
+
+wc_status wc_candidates_build(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                              double r, const wc_particle_arrays *p, const wc_particle_paths *paths,
+                              int32_t steps_left)
+{
+    const wc_bvh *bvh = &col->bvh;
+    if (!allocate(c, el, col) || !lists_init(&c->particles, el->particle_count, 1) ||
+        !lists_init(&c->triangles, el->triangle_count, 3) || !lists_init(&c->edges, el->edge_count, 2))
+        return WC_ERROR_OUT_OF_MEMORY;
+    c->r = r;
+    scratch s = {NULL, 0};
+    int ok = 1;
+    for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, bvh, i, p, paths, steps_left);
+    for (int32_t i = 0; i < el->particle_count && ok; ++i) ok = particle_list(c, &s, col, bvh, i);
+    for (int32_t t = 0; t < el->triangle_count && ok; ++t) ok = triangle_list(c, &s, el, col, bvh, t, col->path);
+    for (int32_t e = 0; e < el->edge_count && ok; ++e) ok = edge_list(c, &s, el, col, bvh, e, col->path);
+    wc_free(s.e);
+    if (!ok) {
+        c->r = 0.0; /* made again at the next use */
+        return WC_ERROR_OUT_OF_MEMORY;
+    }
+    return WC_OK;
+}
+
+wc_status wc_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                               const int32_t *particles, int32_t count, const wc_particle_arrays *p,
+                               const wc_particle_paths *paths, int32_t steps_left, uint8_t *mark)
+{
+    const wc_bvh *bvh = &col->bvh;
+    scratch s = {NULL, 0};
+    int ok = 1;
+    for (int32_t k = 0; k < count; ++k) rebase_one(c, col, bvh, particles[k], p, paths, steps_left);
+    for (int32_t k = 0; k < count && ok; ++k) ok = particle_list(c, &s, col, bvh, particles[k]);
+    /* each triangle and edge of a rebased particle once, in the order met */
+    for (int kind = 0; kind < 2 && ok; ++kind) {
+        const int32_t *start = kind ? el->edges_start : el->triangles_start;
+        const int32_t *items = kind ? el->edges_of : el->triangles_of;
+        for (int32_t k = 0; k < count && ok; ++k)
+            for (int32_t j = start[particles[k]]; j < start[particles[k] + 1] && ok; ++j) {
+                int32_t e = items[j];
+                if (mark[e]) continue;
+                mark[e] = 1;
+                ok = kind ? edge_list(c, &s, el, col, bvh, e, col->path)
+                          : triangle_list(c, &s, el, col, bvh, e, col->path);
+            }
+        for (int32_t k = 0; k < count; ++k)
+            for (int32_t j = start[particles[k]]; j < start[particles[k] + 1]; ++j) mark[items[j]] = 0;
+    }
+    wc_free(s.e);
+    if (!ok) {
+        c->r = 0.0;
+        return WC_ERROR_OUT_OF_MEMORY;
+    }
+    return WC_OK;
+}
+
+double wc_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
+                           const wc_particle_paths *paths)
+{
+    const double *snap = l->snap + (size_t)l->per * (size_t)k;
+    double most = 0.0;
+    for (int j = 0; j < l->per; ++j) {
+        int32_t i = particles[j];
+        /* the end lies on the path after the snapshot; the start after it
+         * too when the snapshot is from an earlier step, else before it */
+        double ahead = paths->path[i] - snap[j], behind = snap[j] - paths->path_start[i];
+        double d = ahead > behind ? ahead : behind;
+        if (d > most) most = d;
+    }
+    return most;
+}
+
+void wc_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
+                         const wc_particle_paths *paths, double collider_path,
+                         const uint8_t *tested, const double *measured, double drift_end)
+{
+    double least = INFINITY;
+    for (int32_t j = 0; j < l->count[k]; ++j) {
+        double *d = l->d + l->start[k];
+        d[j] = tested[j] ? measured[j] : d[j] - drift_end;
+        if (d[j] < least) least = d[j];
+    }
+    l->least[k] = least;
+    l->path_at[k] = collider_path;
+    double *snap = l->snap + (size_t)l->per * (size_t)k;
+    for (int j = 0; j < l->per; ++j) snap[j] = paths->path[particles[j]];
+}

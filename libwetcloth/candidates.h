@@ -1,0 +1,170 @@
+/* Candidate pairs of one cloth against one mesh collider, found seldom and
+ * filtered every step (SPEC 2, "Broadphase, once per frame").
+ *
+ * Three lists, each by owner: per cloth particle the collider triangles
+ * near it (the particle pass), per cloth triangle the collider vertices near
+ * it and per cloth edge the collider edges near it (the feature pass). A
+ * list is made from a reference configuration: its particles at their base
+ * positions (where they were when they were last rebased) and the collider
+ * as it was then; each pair keeps its exact distance d0 there, and a pair
+ * is listed when d0 <= r + M (r the contact distance, M the largest margin
+ * of the owner's particles). A particle's margin comes from its motion when
+ * it is rebased, so a resting cloth keeps its lists for as long as it rests
+ * and a falling one rebases about once per margin travelled.
+ *
+ * The filter and why nothing can tunnel past it. The distance between a
+ * point and a triangle (or two segments, or a vertex and a triangle) changes
+ * by no more than the largest displacement of any of their vertices: every
+ * point of a triangle is a convex combination of its corners, so moving
+ * each corner by at most D moves every point of it by at most D, and a
+ * distance is 1-Lipschitz in each point. Let D_p be the largest distance of
+ * the owner's particles from their base positions at the start and at the
+ * end of the step, and D_c how far any collider vertex can have moved since
+ * the list was made (the collider's path: the sum over steps of its largest
+ * vertex displacement). Motion within a step is linear and the norm convex,
+ * so at every time of the step the particles are within D_p of their bases.
+ * Then at every time of the step
+ *     distance >= d0 - D_p - D_c.
+ * So a listed pair with d0 - D_p - D_c > r cannot come within r during the
+ * step, hence cannot touch or cross: it is skipped for a few loads and a
+ * compare. (The exact test of a feature pair counts a touch only nearer
+ * than r sqrt(1 - slack), narrowphase.h, and that is its threshold.) An
+ * unlisted pair had d0 > r + M, and while every particle keeps
+ * D_p + D_c < its margin (checked every step, and after every response that
+ * moves it), it stays beyond r for the same reason. A particle that breaks
+ * that is rebased: new base, new margin, and its lists and those of its
+ * triangles and edges are made again before they are used. The survivors
+ * get the exact test: continuous where the pair can cross (narrowphase.c).
+ */
+#ifndef WC_CANDIDATES_H
+#define WC_CANDIDATES_H
+
+#include <stdint.h>
+
+#include "broadphase.h"
+#include "collider.h"
+#include "response.h"
+#include "wetcloth.h"
+
+/// Pairs by owner: owner k's items are item[start[k] .. start[k] + count[k]),
+/// ascending, each with a lower bound d[] on its distance in the owner's
+/// snapshot. A list made again writes in place when it fits, else at the end
+/// of the pool.
+///
+/// Snapshots. A list is made with every pair's exact distance at its
+/// particles' bases (and the collider as it was then). The feature pass
+/// measures the distance of the pairs it tests anyway, so after a visit that
+/// pushed nothing it renews the owner's snapshot to the particles' present
+/// ends: tested pairs get the distance just measured, the others their old
+/// bound less how far the owner has moved since. A resting cloth then keeps
+/// bounds a rounding error below the truth, and its pairs at the contact
+/// distance are skipped until they sink by the contact's slack (1 % of r),
+/// instead of being tested at every step. How far an owner has moved since
+/// its snapshot is read from its particles' path lengths (the distance its
+/// end of step has travelled, which no displacement exceeds), noted per
+/// particle of the owner (`per` of them) when the snapshot was taken.
+typedef struct wc_pair_lists {
+    int32_t owner_count;
+    int per;
+    int32_t *start, *count, *room;
+    /// Per owner: the collider's path at its snapshot, the least d of its
+    /// items, and `per` particle path lengths.
+    double *path_at, *least, *snap;
+    int32_t *item;
+    double *d;
+    int64_t used, capacity, garbage;
+} wc_pair_lists;
+
+/// Per particle, kept by the stage that uses the lists (collider_contacts.c):
+/// the length of the path its end of step has travelled (its start of step
+/// lies on it too, at path_start), over the whole run.
+typedef struct wc_particle_paths {
+    const double *path, *path_start;
+} wc_particle_paths;
+
+/// One cloth against one mesh collider.
+typedef struct wc_candidates {
+    /// Contact distance the lists were made for; 0 until made.
+    double r;
+    /// Per particle: base position (xyz), margin, the collider's path and
+    /// its own path length at its last rebase.
+    double *base, *margin, *base_path, *base_length;
+    wc_pair_lists particles, triangles, edges;
+    /// Scratch: collider vertices and edges already gathered for one owner.
+    uint8_t *vertex_seen, *edge_seen;
+    int32_t *found;
+    int32_t found_capacity;
+    int32_t *gathered;
+    double *gathered_d0;
+    int64_t gathered_capacity;
+} wc_candidates;
+
+/// The cloth's side of the lists: its triangles and edges, and per particle
+/// the triangles and edges it belongs to (CSR).
+typedef struct wc_cloth_elements {
+    int32_t particle_count, triangle_count, edge_count;
+    const int32_t *triangles;
+    int32_t *edges;
+    int32_t *triangles_start, *triangles_of, *edges_start, *edges_of;
+} wc_cloth_elements;
+
+void wc_candidates_init(wc_candidates *cand);
+void wc_candidates_free(wc_candidates *cand);
+
+/// Whether particle i, at displacement `d` from its base with the collider
+/// at `path`, is still covered by its lists: what is unlisted stays beyond
+/// reach.
+static inline int wc_candidates_covers(const wc_candidates *cand, int32_t i, double d, double path)
+{
+    return d + (path - cand->base_path[i]) < cand->margin[i];
+}
+
+/// Whether particle i has used more than half its margin: the stage rebases
+/// such particles together before a step, so that neighbours moving
+/// together are rebased in the same step and the lists of their shared
+/// triangles and edges are made once rather than once per particle.
+static inline int wc_candidates_half_used(const wc_candidates *cand, int32_t i, double d, double path)
+{
+    return d + (path - cand->base_path[i]) >= 0.5 * cand->margin[i];
+}
+
+/// Particle i's distance from its base: the larger at the start (x) and at
+/// the end (nx) of the step, which by convexity bounds it over the step.
+double wc_candidates_displacement(const wc_candidates *cand, const wc_particle_arrays *p, int32_t i);
+
+/// Makes every list (first use, or the contact distance changed), with
+/// every particle rebased at its start-of-step position; `steps_left` is
+/// how many steps of the running frame follow this one (margins).
+/// WC_ERROR_OUT_OF_MEMORY on failure.
+wc_status wc_candidates_build(wc_candidates *cand, const wc_cloth_elements *el,
+                              const wc_collider *col, double r, const wc_particle_arrays *p,
+                              const wc_particle_paths *paths, int32_t steps_left);
+
+/// Rebases the `count` particles listed (new base at their start-of-step
+/// position and a new margin) and makes their lists and those of their
+/// triangles and edges again. `mark` is per-element scratch (zero, left
+/// zero), sized for the larger of the cloth's triangle and edge counts.
+wc_status wc_candidates_rebase(wc_candidates *cand, const wc_cloth_elements *el,
+                               const wc_collider *col, const int32_t *particles, int32_t count,
+                               const wc_particle_arrays *p, const wc_particle_paths *paths,
+                               int32_t steps_left, uint8_t *mark);
+
+/// How far owner k's particles can be from where they were at its
+/// snapshot, over the step (starts and ends).
+double wc_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
+                           const wc_particle_paths *paths);
+
+/// After a visit of owner k that moved nothing: its snapshot renewed at its
+/// particles' present ends and the collider's end of step. tested[j] says
+/// whether item j was measured, at distance measured[j]; the others keep
+/// their bound less `drift_end` (how far owner and collider can have moved
+/// from the old snapshot to now).
+void wc_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
+                         const wc_particle_paths *paths, double collider_path,
+                         const uint8_t *tested, const double *measured, double drift_end);
+
+/// Distance from a point to a collider triangle, vertex and edge in the
+/// collider's current positions (what the lists' d0 are measured in).
+double wc_candidates_particle_distance(const wc_collider *col, int32_t triangle, const double p[3]);
+
+#endif

@@ -1,0 +1,793 @@
+#include "collider_contacts.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "candidates.h"
+#include "narrowphase.h"
+#include "parallel.h"
+#include "response.h"
+
+/* A contact distance of zero would leave a resting particle exactly in the
+ * surface, where the side it came from is ambiguous; keep it at least this. */
+#define MIN_CONTACT_DISTANCE 1e-6
+/* Tests of one particle per round: enough for a particle wedged in a
+ * concave corner of two or three surfaces; past it the fail-safe applies. */
+#define PARTICLE_PASSES 4
+/* Passes of the feature pass per round. */
+#define FEATURE_PASSES 8
+/* Rounds of the particle and feature passes. */
+#define ROUNDS 3
+/* The filter keeps a pair unless it is this much beyond the contact
+ * distance (on top of r): far more than the rounding of the distances
+ * behind it, far less than anything physical. */
+#define FILTER_EPSILON(r) (1e-9 * (r) + 1e-12)
+/* A particle's direct query (when it has left its lists' cover mid-pass)
+ * keeps this many triangles on the stack. */
+#define DIRECT_STACK 256
+
+struct wc_collider_contacts {
+    wc_cloth_elements el;
+    /// Per collider (by index): the candidates; made at first use.
+    wc_candidates *cand;
+    int32_t cand_count;
+    int use_filter;
+    /// Between rounds: recheck (the particle pass must test the particle
+    /// again) and shifted (the feature pass must visit its elements).
+    uint8_t *recheck, *shifted;
+    /// Per particle: surface motion of the last face the particle pass
+    /// answered for it, and of the collider feature that last pushed it
+    /// (the fail-safes carry the particle along by them).
+    double *carry;
+    /// Feature pass: particles moved by the previous pass and by the one
+    /// being run, as flags and lists.
+    uint8_t *moved, *moving;
+    int32_t *moved_list, *moving_list;
+    int32_t moved_count, moving_count;
+    /// Particles to rebase (list, and a flag so each is listed once).
+    int32_t *rebase_list;
+    uint8_t *rebase_flag;
+    int32_t rebase_count;
+    /// Per element scratch: a mark and a list.
+    uint8_t *visit_mark;
+    int32_t *visit_list;
+    /// The feature pass' survivors of one element, and per listed item
+    /// whether it was measured and at what distance (snapshots).
+    int32_t *kept;
+    int32_t kept_capacity;
+    uint8_t *tested;
+    double *measured;
+    int32_t tested_capacity;
+    /// Per particle: the length of the path its end of step has travelled
+    /// (over the whole run), that length at the start of the step, where
+    /// the end was when last tracked, and its motion over the step.
+    double *path, *path_start, *last_end, *motion;
+    int tracked;
+};
+
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* ------------------------------------------------------------------------ */
+/* Paths (candidates.h, snapshots)                                          */
+/* ------------------------------------------------------------------------ */
+
+/* Particle i's path goes on to its end of step as it is now. Touches only
+ * particle i's entries (safe in the parallel particle pass). */
+static void track(wc_collider_contacts *s, const wc_particle_arrays *p, int32_t i)
+{
+    double *last = s->last_end + 3 * (size_t)i;
+    double d[3] = {p->nx[i] - last[0], p->ny[i] - last[1], p->nz[i] - last[2]};
+    double step2 = dot3(d, d);
+    if (step2 > 0.0) s->path[i] += sqrt(step2);
+    last[0] = p->nx[i], last[1] = p->ny[i], last[2] = p->nz[i];
+    double u[3] = {p->nx[i] - p->x[i], p->ny[i] - p->y[i], p->nz[i] - p->z[i]};
+    s->motion[i] = sqrt(dot3(u, u));
+}
+
+/* At the start of the stage: each path goes on to the start of the step
+ * (where the end was committed, after whatever moved it since it was last
+ * tracked: self-collision, the wet hold), which is noted, then to its end. */
+static void begin_paths(wc_collider_contacts *s, const wc_particle_arrays *p)
+{
+    for (int32_t i = 0; i < p->count; ++i) {
+        double *last = s->last_end + 3 * (size_t)i;
+        if (!s->tracked) last[0] = p->x[i], last[1] = p->y[i], last[2] = p->z[i];
+        double d[3] = {p->x[i] - last[0], p->y[i] - last[1], p->z[i] - last[2]};
+        double step2 = dot3(d, d);
+        if (step2 > 0.0) s->path[i] += sqrt(step2);
+        s->path_start[i] = s->path[i];
+        last[0] = p->x[i], last[1] = p->y[i], last[2] = p->z[i];
+        track(s, p, i);
+    }
+    s->tracked = 1;
+}
+
+static wc_particle_paths paths_of(const wc_collider_contacts *s)
+{
+    wc_particle_paths paths = {s->path, s->path_start};
+    return paths;
+}
+
+/* ------------------------------------------------------------------------ */
+/* The cloth's elements                                                     */
+/* ------------------------------------------------------------------------ */
+
+static int compare_edge(const void *pa, const void *pb)
+{
+    const int32_t *p = pa, *q = pb;
+    for (int k = 0; k < 3; ++k)
+        if (p[k] != q[k]) return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+/* Inverts a list of elements (`per` particles each) into, per particle,
+ * the elements it belongs to, ascending; 0 on out-of-memory. */
+static int invert_elements(const int32_t *particles, int per, int32_t count, int32_t particle_count,
+                           int32_t **start_out, int32_t **items_out)
+{
+    int32_t *start = wc_alloc_array((size_t)particle_count + 1, sizeof *start);
+    int32_t *items = wc_alloc_array((size_t)per * (size_t)count + 1, sizeof *items);
+    *start_out = start, *items_out = items;
+    if (!start || !items) return 0;
+    for (size_t k = 0; k < (size_t)per * (size_t)count; ++k) start[particles[k] + 1]++;
+    for (int32_t i = 0; i < particle_count; ++i) start[i + 1] += start[i];
+    for (int32_t e = 0; e < count; ++e)
+        for (int p = 0; p < per; ++p) {
+            int32_t i = particles[(size_t)per * (size_t)e + (size_t)p];
+            items[start[i]++] = e; /* start[i] advances as i's slots fill; undone below */
+        }
+    for (int32_t i = particle_count; i > 0; --i) start[i] = start[i - 1];
+    start[0] = 0;
+    return 1;
+}
+
+/* The unique edges of the cloth's triangles, lower index first, sorted. */
+static int build_edges(wc_cloth_elements *el)
+{
+    int32_t nt = el->triangle_count;
+    int32_t *entries = wc_alloc_array(9 * (size_t)nt + 1, sizeof *entries);
+    el->edges = wc_alloc_array(6 * (size_t)nt + 1, sizeof *el->edges);
+    if (!entries || !el->edges) {
+        wc_free(entries);
+        return 0;
+    }
+    for (int32_t t = 0; t < nt; ++t)
+        for (int k = 0; k < 3; ++k) {
+            int32_t a = el->triangles[3 * t + k], b = el->triangles[3 * t + (k + 1) % 3];
+            int32_t *e = entries + 3 * (3 * (size_t)t + k);
+            e[0] = a < b ? a : b, e[1] = a < b ? b : a, e[2] = 3 * t + k;
+        }
+    qsort(entries, 3 * (size_t)nt, 3 * sizeof *entries, compare_edge);
+    for (int32_t k = 0; k < 3 * nt; ++k) {
+        const int32_t *e = entries + 3 * (size_t)k;
+        if (k > 0 && e[0] == e[-3] && e[1] == e[-2]) continue;
+        el->edges[2 * el->edge_count] = e[0];
+        el->edges[2 * el->edge_count + 1] = e[1];
+        ++el->edge_count;
+    }
+    wc_free(entries);
+    return 1;
+}
+
+wc_collider_contacts *wc_collider_contacts_create(const wc_cloth *c)
+{
+    wc_collider_contacts *s = wc_alloc_array(1, sizeof *s);
+    if (!s) return NULL;
+    size_t n = (size_t)c->particle_count;
+    s->use_filter = 1;
+    s->el.particle_count = c->particle_count;
+    s->el.triangle_count = c->topology.triangle_count;
+    s->el.triangles = c->topology.triangles;
+    int ok = build_edges(&s->el) &&
+             invert_elements(s->el.triangles, 3, s->el.triangle_count, c->particle_count,
+                             &s->el.triangles_start, &s->el.triangles_of) &&
+             invert_elements(s->el.edges, 2, s->el.edge_count, c->particle_count,
+                             &s->el.edges_start, &s->el.edges_of);
+    size_t most = (size_t)(s->el.triangle_count > s->el.edge_count ? s->el.triangle_count
+                                                                   : s->el.edge_count) + 1;
+    s->recheck = wc_alloc_array(n, 1);
+    s->shifted = wc_alloc_array(n, 1);
+    s->carry = wc_alloc_array(3 * n, sizeof *s->carry);
+    s->moved = wc_alloc_array(n, 1);
+    s->moving = wc_alloc_array(n, 1);
+    s->moved_list = wc_alloc_array(n, sizeof *s->moved_list);
+    s->moving_list = wc_alloc_array(n, sizeof *s->moving_list);
+    s->rebase_list = wc_alloc_array(n, sizeof *s->rebase_list);
+    s->rebase_flag = wc_alloc_array(n, 1);
+    s->visit_mark = wc_alloc_array(most, 1);
+    s->visit_list = wc_alloc_array(most, sizeof *s->visit_list);
+    s->path = wc_alloc_array(n, sizeof *s->path);
+    s->path_start = wc_alloc_array(n, sizeof *s->path_start);
+    s->last_end = wc_alloc_array(3 * n, sizeof *s->last_end);
+    s->motion = wc_alloc_array(n, sizeof *s->motion);
+    if (!ok || !s->path || !s->path_start || !s->last_end || !s->motion || !s->recheck || !s->shifted || !s->carry || !s->moved || !s->moving ||
+        !s->moved_list || !s->moving_list || !s->rebase_list || !s->rebase_flag ||
+        !s->visit_mark || !s->visit_list) {
+        wc_collider_contacts_destroy(s);
+        return NULL;
+    }
+    return s;
+}
+
+void wc_collider_contacts_destroy(wc_collider_contacts *s)
+{
+    if (!s) return;
+    for (int32_t k = 0; k < s->cand_count; ++k) wc_candidates_free(&s->cand[k]);
+    void *blocks[] = {s->cand, s->el.edges, s->el.triangles_start, s->el.triangles_of,
+                      s->el.edges_start, s->el.edges_of, s->recheck, s->shifted, s->carry,
+                      s->moved, s->moving, s->moved_list, s->moving_list, s->rebase_list,
+                      s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->tested, s->measured,
+                      s->path, s->path_start, s->last_end, s->motion};
+    for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
+    wc_free(s);
+}
+
+void wc_collider_contacts_use_filter(wc_collider_contacts *s, int use) { s->use_filter = use; }
+
+/* ------------------------------------------------------------------------ */
+/* Candidates                                                               */
+/* ------------------------------------------------------------------------ */
+
+static double contact_distance(const wc_cloth *c, const wc_collider *col)
+{
+    double r = c->material.thickness + col->thickness;
+    return r < MIN_CONTACT_DISTANCE ? MIN_CONTACT_DISTANCE : r;
+}
+
+/* How far collider col can have moved since `path_at` by the end of the
+ * step (candidates.h). */
+static double collider_drift(const wc_collider *col, double path_at)
+{
+    return col->path + col->step_motion - path_at;
+}
+
+static int grow_candidates(wc_collider_contacts *s, int32_t count)
+{
+    if (count <= s->cand_count) return 1;
+    wc_candidates *grown = wc_alloc_array((size_t)count, sizeof *grown);
+    if (!grown) return 0;
+    if (s->cand_count) memcpy(grown, s->cand, (size_t)s->cand_count * sizeof *grown);
+    for (int32_t k = s->cand_count; k < count; ++k) wc_candidates_init(&grown[k]);
+    wc_free(s->cand);
+    s->cand = grown, s->cand_count = count;
+    return 1;
+}
+
+static void note_rebase(wc_collider_contacts *s, int32_t i)
+{
+    if (s->rebase_flag[i]) return;
+    s->rebase_flag[i] = 1;
+    s->rebase_list[s->rebase_count++] = i;
+}
+
+/* Rebases the noted particles against collider k and clears the notes. */
+static wc_status flush_rebase(wc_collider_contacts *s, const wc_collider *col, int32_t k,
+                              const wc_particle_arrays *p, int32_t steps_left)
+{
+    wc_status st = WC_OK;
+    wc_particle_paths paths = paths_of(s);
+    if (s->rebase_count)
+        st = wc_candidates_rebase(&s->cand[k], &s->el, col, s->rebase_list, s->rebase_count, p,
+                                  &paths, steps_left, s->visit_mark);
+    for (int32_t j = 0; j < s->rebase_count; ++j) s->rebase_flag[s->rebase_list[j]] = 0;
+    s->rebase_count = 0;
+    return st;
+}
+
+/* Before the passes: the lists of every mesh collider made (first use, or
+ * a new contact distance) or brought up to date for the particles whose
+ * motion in this step leaves their cover. */
+static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
+                                    wc_collider *const *colliders, int32_t count,
+                                    const wc_particle_arrays *p, int32_t steps_left)
+{
+    if (!grow_candidates(s, count)) return WC_ERROR_OUT_OF_MEMORY;
+    for (int32_t k = 0; k < count; ++k) {
+        const wc_collider *col = colliders[k];
+        if (!col->is_mesh) continue;
+        wc_candidates *cand = &s->cand[k];
+        double r = contact_distance(c, col);
+        if (cand->r != r) {
+            wc_particle_paths paths = paths_of(s);
+            if (wc_candidates_build(cand, &s->el, col, r, p, &paths, steps_left))
+                return WC_ERROR_OUT_OF_MEMORY;
+            continue;
+        }
+        double path = col->path + col->step_motion;
+        for (int32_t i = 0; i < c->particle_count; ++i)
+            if (wc_candidates_half_used(cand, i, wc_candidates_displacement(cand, p, i), path))
+                note_rebase(s, i);
+        if (flush_rebase(s, col, k, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+    }
+    return WC_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Particle pass                                                            */
+/* ------------------------------------------------------------------------ */
+
+/* What one particle's tests share. */
+typedef struct particle_run {
+    const wc_particle_arrays *p;
+    int32_t i;
+    double start[3];
+    double mu_cloth, q;
+    int touched;
+    double last_motion[3];
+    int leaves_cover;
+} particle_run;
+
+static void end_now(const particle_run *run, double end[3])
+{
+    const wc_particle_arrays *p = run->p;
+    end[0] = p->nx[run->i], end[1] = p->ny[run->i], end[2] = p->nz[run->i];
+}
+
+/* Answers a touch the narrowphase found; returns whether it moved the
+ * particle. */
+static int answer_particle(particle_run *run, wc_contact *k, const wc_collider *col)
+{
+    uint8_t moved[4];
+    wc_response_options none = {0.0};
+    k->friction = sqrt(run->mu_cloth * col->friction);
+    k->wet_friction = run->q;
+    if (!wc_response_apply(run->p, k, &none, NULL, moved)) return 0;
+    run->touched = 1;
+    for (int m = 0; m < 3; ++m) run->last_motion[m] = k->surface_motion[m];
+    return 1;
+}
+
+/* Triangle t against the particle's motion as it is now. */
+static int test_triangle(particle_run *run, const wc_collider *col, int32_t t, double r)
+{
+    double end[3];
+    wc_contact k;
+    end_now(run, end);
+    if (!wc_narrow_particle_triangle(col, t, run->i, run->start, end, r, &k)) return 0;
+    return answer_particle(run, &k, col);
+}
+
+/* Which pairs get the exact test, and in which order. The answer must not
+ * depend on the candidates' state (where and when particles were rebased,
+ * how large their margins are): a failed step leaves that state changed,
+ * and the retry must give the bits of a run that never failed. So an owner's
+ * pairs are tested in ascending order of the collider item, exactly as if
+ * every item of the collider were tested in turn against the state as it is
+ * then: the lists and the filter only leave out items that cannot touch at
+ * their turn. After a push the particle has moved, so the items after the
+ * one that pushed are gathered again with the new bound. */
+
+/* Positions in owner k's list (ascending by item) of the items after
+ * `after` whose bound is within reach (all of them when `all`), into out
+ * (up to capacity); returns how many (which may exceed capacity). */
+static int32_t survivors(const wc_pair_lists *l, int32_t k, double reach, int all, int32_t after,
+                         int32_t *out, int32_t capacity)
+{
+    if (l->count[k] == 0) return 0; /* (the pool may not exist yet) */
+    const int32_t *item = l->item + l->start[k];
+    const double *d = l->d + l->start[k];
+    int32_t n = 0;
+    for (int32_t j = 0; j < l->count[k]; ++j) {
+        if (item[j] <= after || (!all && d[j] > reach)) continue;
+        if (n < capacity) out[n] = j;
+        ++n;
+    }
+    return n;
+}
+
+/* The collider triangles after `after` whose boxes meet the particle's
+ * motion grown by r, from the tree, in turn; after a push the motion has
+ * changed and the tree is asked again. For a particle outside its lists'
+ * cover, or with more survivors than a stack holds. */
+static int direct_triangles(particle_run *run, const wc_collider *col, double r, int32_t after)
+{
+    int moved = 0;
+    for (;;) {
+        double end[3], box[6];
+        end_now(run, end);
+        for (int k = 0; k < 3; ++k) {
+            box[k] = (run->start[k] < end[k] ? run->start[k] : end[k]) - r;
+            box[k + 3] = (run->start[k] < end[k] ? end[k] : run->start[k]) + r;
+        }
+        int32_t stack[DIRECT_STACK], *found = stack;
+        int32_t n = wc_bvh_query(&col->bvh, box, stack, DIRECT_STACK);
+        if (n > DIRECT_STACK) {
+            found = wc_alloc_array((size_t)n, sizeof *found);
+            if (!found) {
+                /* no room for the list: every triangle in turn */
+                for (int32_t t = after + 1; t < col->triangle_count; ++t) moved |= test_triangle(run, col, t, r);
+                return moved;
+            }
+            wc_bvh_query(&col->bvh, box, found, n);
+        }
+        int32_t pushed = -1;
+        for (int32_t j = 0; j < n && pushed < 0; ++j)
+            if (found[j] > after && test_triangle(run, col, found[j], r)) pushed = found[j];
+        if (found != stack) wc_free(found);
+        if (pushed < 0) return moved;
+        moved = 1, after = pushed;
+    }
+}
+
+/* One mesh collider against the particle: the items of its list that the
+ * filter keeps (candidates.h), in turn. */
+static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_collider *col,
+                         double r, int use_filter)
+{
+    const wc_particle_arrays *p = run->p;
+    const wc_pair_lists *l = &cand->particles;
+    int32_t i = run->i, after = -1, kept[DIRECT_STACK];
+    double path = col->path + col->step_motion, drift = collider_drift(col, l->path_at[i]);
+    int moved = 0;
+    for (;;) {
+        double d = wc_candidates_displacement(cand, p, i);
+        if (!wc_candidates_covers(cand, i, d, path)) {
+            run->leaves_cover = 1;
+            return moved | direct_triangles(run, col, r, after);
+        }
+        double reach = r + d + drift + FILTER_EPSILON(r);
+        int32_t n = survivors(l, i, reach, !use_filter, after, kept, DIRECT_STACK);
+        if (n > DIRECT_STACK) return moved | direct_triangles(run, col, r, after);
+        if (n == 0) return moved;
+        const int32_t *item = l->item + l->start[i];
+        int32_t pushed = -1;
+        for (int32_t j = 0; j < n && pushed < 0; ++j)
+            if (test_triangle(run, col, item[kept[j]], r)) pushed = item[kept[j]];
+        if (pushed < 0) return moved;
+        moved = 1, after = pushed;
+    }
+}
+
+/* Particle i against every collider, up to PARTICLE_PASSES times; returns
+ * 1 if it was still being moved after the last (fail-safe), and sets
+ * *touched. */
+static int particle_passes(wc_collider_contacts *s, const wc_cloth *c, wc_collider *const *colliders,
+                           int32_t count, particle_run *run)
+{
+    const wc_particle_arrays *p = run->p;
+    int moved = 1;
+    for (int pass = 0; pass < PARTICLE_PASSES && moved; ++pass) {
+        moved = 0;
+        for (int32_t k = 0; k < count; ++k) {
+            const wc_collider *col = colliders[k];
+            double r = contact_distance(c, col);
+            if (col->is_mesh) {
+                moved |= mesh_particle(run, &s->cand[k], col, r, s->use_filter);
+            } else {
+                double end[3];
+                wc_contact ct;
+                end_now(run, end);
+                if (wc_narrow_particle_convex(col, run->i, run->start, end, r, &ct))
+                    moved |= answer_particle(run, &ct, col);
+            }
+        }
+    }
+    (void)p;
+    return moved;
+}
+
+static int32_t particle_pass(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
+                             wc_collider *const *colliders, int32_t count, int threads, int all)
+{
+    int32_t n = c->particle_count, failsafe = 0;
+    (void)threads;
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads) if (n >= WC_PARALLEL_MIN) \
+    reduction(+ : failsafe)
+    for (int32_t i = 0; i < n; ++i) {
+        if (c->pin_slot[i] >= 0 || !(all || s->recheck[i])) continue;
+        s->recheck[i] = 0;
+        particle_run run;
+        run.p = p, run.i = i;
+        run.start[0] = c->x[i], run.start[1] = c->y[i], run.start[2] = c->z[i];
+        run.mu_cloth = c->material.friction, run.q = c->material.wet_friction;
+        run.touched = 0, run.leaves_cover = 0;
+        run.last_motion[0] = run.last_motion[1] = run.last_motion[2] = 0.0;
+        int stuck = particle_passes(s, c, colliders, count, &run);
+        if (!run.touched) continue;
+        if (stuck) {
+            /* Still pushed around after every pass: wedged between
+             * surfaces. Keep the place relative to the surface it last
+             * touched that it had at the start of the step, free of
+             * intersection: move with that surface (at rest if static). */
+            c->nx[i] = c->x[i] + run.last_motion[0];
+            c->ny[i] = c->y[i] + run.last_motion[1];
+            c->nz[i] = c->z[i] + run.last_motion[2];
+            c->qx[i] = c->x[i], c->qy[i] = c->y[i], c->qz[i] = c->z[i];
+            c->history_override[i] = 1;
+            ++failsafe;
+            s->recheck[i] = 1;
+        }
+        for (int m = 0; m < 3; ++m) s->carry[3 * (size_t)i + m] = run.last_motion[m];
+        s->shifted[i] = 1;
+        track(s, p, i);
+    }
+    return failsafe;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Feature pass                                                             */
+/* ------------------------------------------------------------------------ */
+
+/* Collider vertices against cloth triangles (count 3) or collider edges
+ * against cloth edges (count 2). */
+typedef struct element_kind {
+    int count;
+    const int32_t *particles;
+    const wc_pair_lists *lists;
+    const int32_t *start, *of; /* per particle: its elements (CSR) */
+} element_kind;
+
+/* Largest displacement over the step of the collider feature's vertices. */
+static double feature_motion(const wc_collider *col, const element_kind *kind, int32_t f)
+{
+    if (!col->moving) return 0.0;
+    const int32_t *v = kind->count == 3 ? &f : col->edges + 2 * (size_t)f;
+    int n = kind->count == 3 ? 1 : 2;
+    double most2 = 0.0;
+    for (int k = 0; k < n; ++k) {
+        const double *a = col->current + 3 * (size_t)v[k], *b = col->next + 3 * (size_t)v[k];
+        double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        if (dot3(d, d) > most2) most2 = dot3(d, d);
+    }
+    return sqrt(most2);
+}
+
+/* Notes what a push moved: for the next pass, for the particle pass, what
+ * the fail-safe would carry it along by, and its path; a particle pushed
+ * out of its cover against any collider is rebased there at once, so every
+ * list stays whole. */
+static wc_status note_pushed(wc_collider_contacts *s, const wc_particle_arrays *p,
+                             wc_collider *const *colliders, int32_t count, const wc_contact *k,
+                             const uint8_t moved[4], int32_t steps_left)
+{
+    for (int j = 0; j < k->count; ++j) {
+        if (!moved[j]) continue;
+        int32_t i = k->particle[j];
+        if (!s->moving[i]) s->moving[i] = 1, s->moving_list[s->moving_count++] = i;
+        s->recheck[i] = 1;
+        for (int m = 0; m < 3; ++m) s->carry[3 * (size_t)i + m] = k->surface_motion[m];
+        track(s, p, i);
+    }
+    for (int32_t c = 0; c < count; ++c) {
+        const wc_collider *col = colliders[c];
+        if (!col->is_mesh) continue;
+        double path = col->path + col->step_motion;
+        for (int j = 0; j < k->count; ++j)
+            if (moved[j] && !wc_candidates_covers(&s->cand[c], k->particle[j],
+                                                  wc_candidates_displacement(&s->cand[c], p, k->particle[j]), path))
+                note_rebase(s, k->particle[j]);
+        if (flush_rebase(s, col, c, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+    }
+    return WC_OK;
+}
+
+/* Whether a feature pair can touch, by the exact test's own threshold: a
+ * proximity counts only nearer than r sqrt(1 - slack), a crossing only at
+ * distance 0 (tolerance 1e-9 r). */
+static double feature_reach(double r) { return r * sqrt(1.0 - WC_FEATURE_SLACK); }
+
+/* Room for the survivors and measurements of a list of n items. */
+static int feature_scratch(wc_collider_contacts *s, int32_t n)
+{
+    if (n <= s->kept_capacity && n <= s->tested_capacity) return 1;
+    int32_t cap = 2 * n + 16;
+    int32_t *kept = wc_alloc_array((size_t)cap, sizeof *kept);
+    uint8_t *tested = wc_alloc_array((size_t)cap, 1);
+    double *measured = wc_alloc_array((size_t)cap, sizeof *measured);
+    if (!kept || !tested || !measured) {
+        wc_free(kept), wc_free(tested), wc_free(measured);
+        return 0;
+    }
+    wc_free(s->kept), wc_free(s->tested), wc_free(s->measured);
+    s->kept = kept, s->tested = tested, s->measured = measured;
+    s->kept_capacity = s->tested_capacity = cap;
+    return 1;
+}
+
+/* Element e against the collider features its list keeps through the
+ * filter, in ascending order of the feature (see survivors), gathered again
+ * after each push. A visit that pushed nothing renews the element's
+ * snapshot (candidates.h). Returns 1 if it pushed anything, -1 on
+ * out-of-memory. */
+static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
+                         wc_collider *const *colliders, int32_t count, int32_t k,
+                         const element_kind *kind, int32_t e, double r, int32_t steps_left)
+{
+    const wc_collider *col = colliders[k];
+    const int32_t *idx = kind->particles + (size_t)kind->count * (size_t)e;
+    const wc_pair_lists *l = kind->lists;
+    wc_particle_paths paths = paths_of(s);
+    double reach = feature_reach(r) + FILTER_EPSILON(r);
+    double drift = wc_pair_lists_drift(l, e, idx, &paths) + collider_drift(col, l->path_at[e]);
+    /* nothing in the list can touch: the cheap way out of most visits */
+    if (!s->use_filter ? l->count[e] == 0 : l->least[e] - drift > reach) return 0;
+    double mu = sqrt(c->material.friction * col->friction);
+    int32_t after = -1;
+    int pushed = 0;
+    if (!feature_scratch(s, l->count[e])) return -1;
+    memset(s->tested, 0, (size_t)l->count[e]);
+    for (;;) {
+        /* a push may have rebased the list and grown it; what was measured
+         * before is of no use then (no renewal after a push) */
+        if (pushed && !feature_scratch(s, l->count[e])) return -1;
+        double motion = 0.0;
+        for (int j = 0; j < kind->count; ++j)
+            if (s->motion[idx[j]] > motion) motion = s->motion[idx[j]];
+        int32_t n = survivors(l, e, reach + drift, !s->use_filter, after, s->kept, s->kept_capacity);
+        int32_t hit = -1;
+        for (int32_t j = 0; j < n && hit < 0; ++j) {
+            int32_t at = s->kept[j], f = l->item[l->start[e] + at];
+            double fm = feature_motion(col, kind, f);
+            int ccd = wc_narrow_needs_ccd(motion > fm ? motion : fm, r);
+            double d2;
+            wc_contact ct;
+            int touch = kind->count == 3 ? wc_narrow_vertex_triangle(p, idx, col, f, ccd, r, &d2, &ct)
+                                         : wc_narrow_edge_edge(p, idx, col, f, ccd, r, &d2, &ct);
+            s->tested[at] = 1, s->measured[at] = sqrt(d2);
+            if (!touch) continue;
+            ct.friction = mu, ct.wet_friction = c->material.wet_friction;
+            uint8_t moved[4];
+            wc_response_options none = {0.0};
+            if (!wc_response_apply(p, &ct, &none, NULL, moved)) continue;
+            if (note_pushed(s, p, colliders, count, &ct, moved, steps_left)) return -1;
+            hit = f;
+        }
+        if (hit < 0) break;
+        pushed = 1, after = hit;
+        /* the push moved the element (and perhaps rebased its list) */
+        drift = wc_pair_lists_drift(l, e, idx, &paths) + collider_drift(col, l->path_at[e]);
+    }
+    if (!pushed) {
+        /* measured at the ends as they are: a fresh snapshot */
+        double end_drift = 0.0;
+        const double *snap = l->snap + (size_t)l->per * (size_t)e;
+        for (int j = 0; j < kind->count; ++j)
+            if (s->path[idx[j]] - snap[j] > end_drift) end_drift = s->path[idx[j]] - snap[j];
+        end_drift += collider_drift(col, l->path_at[e]);
+        wc_pair_lists_renew((wc_pair_lists *)l, e, idx, &paths, col->path + col->step_motion,
+                            s->tested, s->measured, end_drift);
+    }
+    return pushed;
+}
+
+/* Into s->visit_list, ascending, the elements of a kind with a particle
+ * the last pass moved; returns how many. */
+static int32_t moved_elements(wc_collider_contacts *s, const element_kind *kind)
+{
+    int32_t lo = INT32_MAX, hi = -1;
+    for (int32_t m = 0; m < s->moved_count; ++m) {
+        int32_t i = s->moved_list[m];
+        for (int32_t j = kind->start[i]; j < kind->start[i + 1]; ++j) {
+            int32_t e = kind->of[j];
+            s->visit_mark[e] = 1;
+            if (e < lo) lo = e;
+            if (e > hi) hi = e;
+        }
+    }
+    int32_t n = 0;
+    for (int32_t e = lo; e <= hi; ++e)
+        if (s->visit_mark[e]) s->visit_mark[e] = 0, s->visit_list[n++] = e;
+    return n;
+}
+
+/* One kind of element against collider k: all elements with candidates in
+ * a first pass, else those with a particle the last pass moved, ascending.
+ * Returns 1 if anything moved, -1 on out-of-memory. */
+static int element_pass(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
+                        wc_collider *const *colliders, int32_t collider_count, int32_t k,
+                        const element_kind *kind, int only_moved, double r, int32_t steps_left)
+{
+    int32_t count = only_moved ? moved_elements(s, kind) : kind->lists->owner_count;
+    int moved = 0;
+    for (int32_t m = 0; m < count; ++m) {
+        int32_t e = only_moved ? s->visit_list[m] : m;
+        if (kind->lists->count[e] == 0) continue;
+        int result = visit_element(s, c, p, colliders, collider_count, k, kind, e, r, steps_left);
+        if (result < 0) return -1;
+        moved |= result;
+    }
+    return moved;
+}
+
+static void clear_marks(uint8_t *flags, const int32_t *list, int32_t *count)
+{
+    for (int32_t k = 0; k < *count; ++k) flags[list[k]] = 0;
+    *count = 0;
+}
+
+/* The feature pass: passes over every mesh collider until nothing moves
+ * (FEATURE_PASSES at most), then the fail-safe for what the last one still
+ * moved. Returns 1 if anything moved, -1 on out-of-memory. */
+static int feature_pass(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
+                        wc_collider *const *colliders, int32_t count, int all, int32_t steps_left,
+                        int32_t *failsafe)
+{
+    /* the first pass looks at what the particle pass moved as if a pass of
+     * its own had moved it */
+    clear_marks(s->moved, s->moved_list, &s->moved_count);
+    clear_marks(s->moving, s->moving_list, &s->moving_count);
+    for (int32_t i = 0; i < c->particle_count && !all; ++i)
+        if (s->shifted[i]) s->moved[i] = 1, s->moved_list[s->moved_count++] = i;
+    memset(s->shifted, 0, (size_t)c->particle_count);
+    int moved = 1, any = 0;
+    for (int pass = 0; pass < FEATURE_PASSES && moved; ++pass) {
+        int only_moved = pass > 0 || !all;
+        clear_marks(s->moving, s->moving_list, &s->moving_count);
+        moved = 0;
+        for (int32_t k = 0; k < count; ++k) {
+            const wc_collider *col = colliders[k];
+            if (!col->is_mesh) continue;
+            double r = contact_distance(c, col);
+            const wc_candidates *cand = &s->cand[k];
+            element_kind triangles = {3, s->el.triangles, &cand->triangles, s->el.triangles_start,
+                                      s->el.triangles_of};
+            element_kind edges = {2, s->el.edges, &cand->edges, s->el.edges_start, s->el.edges_of};
+            int a = element_pass(s, c, p, colliders, count, k, &triangles, only_moved, r, steps_left);
+            if (a < 0) return -1;
+            int b = element_pass(s, c, p, colliders, count, k, &edges, only_moved, r, steps_left);
+            if (b < 0) return -1;
+            moved |= a | b;
+        }
+        uint8_t *swap = s->moved;
+        s->moved = s->moving, s->moving = swap;
+        int32_t *swap_list = s->moved_list, swap_count = s->moved_count;
+        s->moved_list = s->moving_list, s->moved_count = s->moving_count;
+        s->moving_list = swap_list, s->moving_count = swap_count;
+        any |= moved;
+    }
+    if (!moved) return any;
+    /* Fail-safe: what the last pass still had to move keeps its position
+     * relative to the collider feature that last pushed it, as at the start
+     * of the step (free of intersection): it moves with the feature and
+     * takes its velocity (for a static collider: stays where it was, at
+     * rest). */
+    for (int32_t m = 0; m < s->moved_count; ++m) {
+        int32_t i = s->moved_list[m];
+        const double *carry = s->carry + 3 * (size_t)i;
+        c->nx[i] = c->x[i] + carry[0], c->qx[i] = c->x[i];
+        c->ny[i] = c->y[i] + carry[1], c->qy[i] = c->y[i];
+        c->nz[i] = c->z[i] + carry[2], c->qz[i] = c->z[i];
+        c->history_override[i] = 1;
+        s->shifted[i] = 1;
+        track(s, p, i);
+        ++*failsafe;
+    }
+    return any;
+}
+
+/* ------------------------------------------------------------------------ */
+/* The stage                                                                */
+/* ------------------------------------------------------------------------ */
+
+wc_status wc_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
+                                       wc_collider *const *colliders, int32_t count,
+                                       int32_t steps_left, int threads, wc_step_stats *stats)
+{
+    if (count <= 0) return WC_OK;
+    wc_particle_arrays p = wc_particle_arrays_of(c);
+    begin_paths(s, &p);
+    if (refresh_candidates(s, c, colliders, count, &p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+    memset(s->shifted, 0, (size_t)c->particle_count);
+    int32_t failsafe = 0;
+    for (int round = 0; round < ROUNDS; ++round) {
+        failsafe += particle_pass(s, c, &p, colliders, count, threads, round == 0);
+        /* particles that left their cover during the pass are rebased for
+         * the feature pass and the next step */
+        for (int32_t k = 0; k < count; ++k) {
+            if (!colliders[k]->is_mesh) continue;
+            double path = colliders[k]->path + colliders[k]->step_motion;
+            for (int32_t i = 0; i < c->particle_count; ++i)
+                if (s->shifted[i] &&
+                    !wc_candidates_covers(&s->cand[k], i, wc_candidates_displacement(&s->cand[k], &p, i), path))
+                    note_rebase(s, i);
+            if (flush_rebase(s, colliders[k], k, &p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+        }
+        int moved = feature_pass(s, c, &p, colliders, count, round == 0, steps_left, &failsafe);
+        if (moved < 0) return WC_ERROR_OUT_OF_MEMORY;
+        if (!moved) break;
+    }
+    stats->failsafe_particles += failsafe;
+    return WC_OK;
+}

@@ -1,0 +1,56 @@
+/* The cloth-against-colliders stage of a step (SPEC 2): candidates, the
+ * per-step filter, the exact tests and the response, for one cloth against
+ * every collider of the world.
+ *
+ *  1. Candidates (candidates.h): each mesh collider keeps, per cloth, lists
+ *     of the pairs that may come within the contact distance r, made from
+ *     the collider's tree (broadphase.h) and kept while every particle stays
+ *     within its margin of where the lists were made. Particles that left
+ *     theirs are rebased first, so the passes below find the lists whole.
+ *  2. Particle pass (parallel over particles: each touches only its own
+ *     state): each particle's motion against the collider triangles its list
+ *     keeps through the filter (a prefix of the list sorted by distance),
+ *     and against the convex shapes; a touch is a contact record answered at
+ *     once (response.h), and the particle is tested again, up to
+ *     PARTICLE_PASSES times, since one push can bring it to another face.
+ *  3. Feature pass (serial, in a fixed order: collider, element, candidate):
+ *     collider vertices against cloth triangles and collider edges against
+ *     cloth edges, which step 2 alone misses (a faceted solid's vertices
+ *     stand proud of its faces; a thin plate's rim cuts between particles).
+ *     Its first pass visits every element with candidates, a later one only
+ *     those with a particle the last one moved.
+ *  Steps 2 and 3 alternate, each looking only at what the other moved,
+ *  until step 3 moves nothing (at most ROUNDS rounds).
+ *  4. Fail-safes: a particle still pushed around after its passes keeps the
+ *     place relative to the surface it last touched that it had at the start
+ *     of the step (free of intersection): it moves with that surface. */
+#ifndef WC_COLLIDER_CONTACTS_H
+#define WC_COLLIDER_CONTACTS_H
+
+#include "cloth.h"
+#include "collider.h"
+
+/// Per-cloth buffers of the stage. Opaque.
+typedef struct wc_collider_contacts wc_collider_contacts;
+
+/// NULL on out-of-memory.
+wc_collider_contacts *wc_collider_contacts_create(const wc_cloth *cloth);
+void wc_collider_contacts_destroy(wc_collider_contacts *state);
+
+/// Resolves the cloth's motion x -> nx against every collider: moves nx,
+/// sets history overrides and collider contacts (kind and normal). The
+/// colliders have begun their step (wc_collider_begin_step). `steps_left`
+/// is how many steps of the running advance follow this one (the
+/// candidates' margins look that far ahead). Adds fail-safe particles to
+/// stats. Deterministic for any thread count. WC_ERROR_OUT_OF_MEMORY on
+/// out-of-memory.
+wc_status wc_collider_contacts_resolve(wc_cloth *cloth, wc_collider_contacts *state,
+                                       wc_collider *const *colliders, int32_t collider_count,
+                                       int32_t steps_left, int threads, wc_step_stats *stats);
+
+/// Test switch: 1 (default) skips the pairs the filter proves apart, 0
+/// gives every listed pair the exact test. The results are the same bit for
+/// bit; tests compare the two.
+void wc_collider_contacts_use_filter(wc_collider_contacts *state, int use);
+
+#endif

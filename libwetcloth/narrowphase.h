@@ -1,0 +1,68 @@
+/* Narrowphase of cloth against colliders: the exact tests of the pairs the
+ * candidates' filter kept (candidates.h), each turning a touch into a
+ * contact record (response.h) that the response then answers.
+ *
+ *  * A particle against a collider triangle: proximity within the contact
+ *    distance r at the end of the step, and for a crossing during the step
+ *    the thesis' plane test (eq. 2.5-2.6: the signed distances at the two
+ *    ends of the motion differ in sign, the crossing point lies in the
+ *    triangle) against a static triangle, which is linear, or the
+ *    coplanarity cubic on the relative motion against a moving one.
+ *  * A particle against a convex shape: libccd's support functions
+ *    (convex.c), the motion taken into the shape's frame.
+ *  * A collider vertex against a cloth triangle, a collider edge against a
+ *    cloth edge (the faceted solid's proud vertices and edges, a thin
+ *    plate's rim): proximity, and the continuous test when the pair moves
+ *    relative to each other by more than r.
+ *
+ * The side a cloth element belongs on is the side it was on at the start
+ * of the step, read along a direction that cannot turn over without a
+ * crossing (turning_cross). All tests only read. */
+#ifndef WC_NARROWPHASE_H
+#define WC_NARROWPHASE_H
+
+#include "collider.h"
+#include "response.h"
+
+/// A contact counts for the feature tests only if it is deeper than this
+/// fraction of the contact distance: where a collider corner and its edges
+/// push the same cloth element in turn, what is left shrinks geometrically
+/// rather than vanishing, and 1 % of r left over is harmless (an
+/// intersection needs a violation of the whole contact distance).
+#define WC_FEATURE_SLACK 1e-2
+
+/// Particle moving from start to end against collider triangle t of a mesh
+/// collider at contact distance r. Returns 1 and fills the record (source,
+/// count 1 with the particle index `particle`, normal, distance, target r,
+/// surface motion, place; friction left to the caller) on a touch.
+int wc_narrow_particle_triangle(const wc_collider *col, int32_t t, int32_t particle,
+                                const double start[3], const double end[3], double r,
+                                wc_contact *out);
+
+/// The same against a convex collider.
+int wc_narrow_particle_convex(const wc_collider *col, int32_t particle, const double start[3],
+                              const double end[3], double r, wc_contact *out);
+
+/// Whether a pair that moves relative to each other by up to `motion` (the
+/// largest displacement of any of its points over the step, twice of which
+/// bounds the relative motion) needs the continuous test at contact
+/// distance r: the pair was at least r apart at the start (the previous step
+/// saw to it) and distance changes no faster than the points move, so with
+/// less relative motion than r a crossing still ends within r, where the
+/// proximity test sees it and takes the side from the start.
+int wc_narrow_needs_ccd(double motion, double r);
+
+/// Collider vertex v against cloth triangle `tri` (3 particle indices) of
+/// the particle arrays. *d2 gets the squared distance at the end of the step
+/// before any response. Returns 1 and fills the record on a touch deeper
+/// than the slack.
+int wc_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t tri[3],
+                              const wc_collider *col, int32_t v, int ccd, double r, double *d2,
+                              wc_contact *out);
+
+/// Collider edge f against cloth edge `edge` (2 particle indices); as
+/// wc_narrow_vertex_triangle.
+int wc_narrow_edge_edge(const wc_particle_arrays *p, const int32_t edge[2], const wc_collider *col,
+                        int32_t f, int ccd, double r, double *d2, wc_contact *out);
+
+#endif
