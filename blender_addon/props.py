@@ -99,7 +99,7 @@ class WetClothSettings(bpy.types.PropertyGroup):
                ("IMPLICIT", "Semi-Implicit",
                 "Implicit steps solved with conjugate gradients: stable with few steps per frame, "
                 "a little more damped; the best choice for large cloths")],
-        default="VERLET", update=_result_changed,
+        default="IMPLICIT", update=_result_changed,
         description="How each step moves the cloth forward in time")
     substeps_auto: BoolProperty(
         name="Automatic", default=True, update=_result_changed,

@@ -311,6 +311,14 @@ static wc_status index_mesh(wc_collider *c)
     }
     if (c->bvh.node_count == 0) {
         if (wc_bvh_build(&c->bvh, c->boxes, c->triangle_count)) return WC_ERROR_OUT_OF_MEMORY;
+        double total = 0.0;
+        for (int32_t e = 0; e < c->edge_count; ++e) {
+            const double *a = c->current + 3 * (size_t)c->edges[2 * (size_t)e];
+            const double *b = c->current + 3 * (size_t)c->edges[2 * (size_t)e + 1];
+            double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            total += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        }
+        c->feature_size = c->edge_count ? total / c->edge_count : 0.0;
     } else {
         wc_bvh_refit(&c->bvh);
     }

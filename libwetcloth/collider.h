@@ -63,6 +63,9 @@ typedef struct wc_collider {
     wc_bvh bvh;
     /// Whether the boxes and the tree describe the running advance.
     int indexed;
+    /// Mean length of the triangles' edges when the tree was built: the
+    /// scale of the collider's features (candidates.c, margins).
+    double feature_size;
     /// Unit normal of each triangle while the collider stands still (zero
     /// for a degenerate triangle, which is then ignored), valid while
     /// normals_current; a moving collider's are made where a test needs

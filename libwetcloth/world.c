@@ -57,7 +57,7 @@ wc_world_def wc_world_def_default(void)
     memset(&d, 0, sizeof d);
     d.gravity[2] = -9.81;
     d.thread_count = 0;
-    d.integrator = WC_INTEGRATOR_VERLET;
+    d.integrator = WC_INTEGRATOR_IMPLICIT;
     d.substep_safety = 0.9;
     d.max_substeps = 100000;
     d.implicit_tolerance = 1.0;

@@ -57,6 +57,11 @@ wc_world *scene_world_from(const wc_world_def *def)
 wc_world *scene_world(int32_t threads)
 {
     wc_world_def def = wc_world_def_default();
+    /* The scenes' criteria were measured with Verlet, the thesis' own
+     * integrator and the reference the others are measured against; the
+     * default (the implicit integrator) has tests of its own
+     * (test_integrators.c). */
+    def.integrator = WC_INTEGRATOR_VERLET;
     def.thread_count = threads;
     return scene_world_from(&def);
 }

@@ -125,8 +125,36 @@ static void test_triangle_pairs(void)
                 q[i][k] = 0.3 + q2[i][0] * u[k] + q2[i][1] * v[k];
             }
         expect_pair((const double(*)[3])p, (const double(*)[3])q, 0, "slanted coplanar, separate");
+        /* q's corner moved over p: in exact arithmetic the rounded corners
+         * all lie a rounding error above p's plane, so the two only come
+         * within 1e-17 m of each other and do not intersect (the checker's
+         * predicates are exact: close is not touching) */
         for (int k = 0; k < 3; ++k) q[0][k] = 0.3 + 0.4 * u[k] + 0.4 * v[k];
-        expect_pair((const double(*)[3])p, (const double(*)[3])q, 1, "slanted coplanar, overlapping");
+        expect_pair((const double(*)[3])p, (const double(*)[3])q, 0,
+                    "slanted nearly coplanar, over each other by rounding only");
+    }
+    {
+        /* exactly coplanar in a slanted plane, x + 2 y + 4 z = 1 (dyadic
+         * coordinates, so every corner is on it exactly): overlapping, then
+         * moved apart along the plane, then touching at a corner */
+        const double p[3][3] = {{1, 0, 0}, {0, 0.5, 0}, {0, 0, 0.25}};
+        double q[3][3] = {{0.5, 0.125, 0.0625}, {1, 0.5, -0.25}, {1, -0.5, 0.25}};
+        expect_pair(p, (const double(*)[3])q, 1, "slanted coplanar, overlapping");
+        for (int i = 0; i < 3; ++i) q[i][0] += 6, q[i][1] -= 3;
+        expect_pair(p, (const double(*)[3])q, 0, "slanted coplanar, moved apart along the plane");
+        const double r[3][3] = {{1, 0, 0}, {2, 0.5, -0.5}, {2, -0.5, 0}};
+        expect_pair(p, r, 1, "slanted coplanar, touching at a corner");
+    }
+    {
+        /* A layer a hair above another: 1e-15 m is far more than nothing,
+         * so no intersection, however close; touching exactly counts. */
+        const double a[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+        const double b[3][3] = {{-0.5, 0.2, 1e-15}, {1.5, 0.2, 1e-15}, {0.2, 1.5, 1e-15}};
+        expect_pair(a, b, 0, "a layer 1e-15 m above another");
+        const double c[3][3] = {{0.2, 0.2, 1e-300}, {0.3, 0.2, 1}, {0.2, 0.4, 1}};
+        expect_pair(a, c, 0, "a corner 1e-300 m above a face");
+        const double d[3][3] = {{0.2, 0.2, 0}, {0.3, 0.2, 1}, {0.2, 0.4, 1}};
+        expect_pair(a, d, 1, "a corner exactly on a face");
     }
     {
         /* Two triangles of a 64 x 64 sheet falling flat, half a cell apart,

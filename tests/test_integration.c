@@ -22,6 +22,9 @@ static const double PI = 3.14159265358979323846;
 static wc_world *new_world(const double gravity[3], int32_t threads)
 {
     wc_world_def def = wc_world_def_default();
+    /* Verlet's own properties (exact free fall, a spring's period, the
+     * stable step): the other integrators' are in test_integrators.c */
+    def.integrator = WC_INTEGRATOR_VERLET;
     for (int k = 0; k < 3; ++k) def.gravity[k] = gravity[k];
     def.thread_count = threads;
     wc_world *w = NULL;

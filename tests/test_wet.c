@@ -34,6 +34,7 @@ static double seconds(void)
 static wc_world *world_with_gravity(double gz)
 {
     wc_world_def def = wc_world_def_default();
+    def.integrator = WC_INTEGRATOR_VERLET; /* as scene_world (scenes.c) */
     def.thread_count = 1;
     def.gravity[2] = gz;
     return scene_world_from(&def);

@@ -54,6 +54,8 @@ static pair_def pair_def_default(void)
 static wc_world *make_pair(const pair_def *d)
 {
     wc_world_def def = wc_world_def_default();
+    /* measured with Verlet (its momentum is exact to rounding) */
+    def.integrator = WC_INTEGRATOR_VERLET;
     def.thread_count = d->threads;
     memcpy(def.gravity, d->gravity, sizeof def.gravity);
     wc_world *w = NULL;

@@ -28,10 +28,14 @@
  * Collision modifier default, which the add-on passes on), friction (the
  * collider's, 0.5), size (override the cloth's particle count per side),
  * out (file: float64 positions of every frame, for error measurement),
+ * adhesion, spread, wet_friction, damping (stretch damping; the cloth
+ * material's, for experiments),
  * check (1: count intersections at the last frame; 2: at every frame).
  *
  * Printed: ms per frame (wall), collision ms per frame (the library's
- * collide phase), substeps per frame, intersections, the highest particle
+ * collide phase), substeps per frame, intersections (all, and cloth against
+ * the collider: without self-collision a cloth may pass through itself),
+ * fail-safe particles (summed over the last substep of each frame), the highest particle
  * after landing against the start height, the longest stretch link over
  * the run as a multiple of its rest length, and whether every position
  * stayed finite. Landing is the first frame with a collider contact. */
@@ -51,7 +55,7 @@ typedef struct options {
     const char *scene;
     int frames, steps, threads, wet, self, size, check, steps_given;
     const char *integrator;
-    double thickness, friction;
+    double thickness, friction, adhesion, spread, wet_friction, damping;
     const char *out;
 } options;
 
@@ -157,7 +161,7 @@ static int parse(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->scene = "thesis", o->frames = 24, o->threads = 1, o->thickness = 0.02, o->friction = 0.5;
-    o->integrator = "default", o->check = 1;
+    o->integrator = "default", o->check = 1, o->adhesion = -1.0, o->spread = -1.0, o->wet_friction = -1.0, o->damping = -1.0;
     for (int k = 1; k < argc; ++k) {
         char *eq = strchr(argv[k], '=');
         if (!eq) return 0;
@@ -175,6 +179,10 @@ static int parse(int argc, char **argv, options *o)
         else if (!strcmp(key, "thickness")) o->thickness = atof(val);
         else if (!strcmp(key, "friction")) o->friction = atof(val);
         else if (!strcmp(key, "out")) o->out = val;
+        else if (!strcmp(key, "adhesion")) o->adhesion = atof(val);
+        else if (!strcmp(key, "spread")) o->spread = atof(val);
+        else if (!strcmp(key, "wet_friction")) o->wet_friction = atof(val);
+        else if (!strcmp(key, "damping")) o->damping = atof(val);
         else return 0;
     }
     return o->frames > 0;
@@ -235,6 +243,10 @@ static scene make_scene(const options *o)
     g.center[2] = height;
     g.self_collision = o->self;
     g.wetness = o->wet ? 1.0 : 0.0;
+    if (o->adhesion >= 0.0) g.material.adhesion = o->adhesion;
+    if (o->spread >= 0.0) g.material.spread = o->spread;
+    if (o->wet_friction >= 0.0) g.material.wet_friction = o->wet_friction;
+    if (o->damping >= 0.0) g.material.stretch_damping = o->damping;
     bench_check(wc_world_add_grid_cloth(s.world, &g, &s.cloth), s.world, "add cloth");
     s.start_height = height;
     return s;
@@ -283,7 +295,8 @@ int main(int argc, char **argv)
     int steps = o.steps_given ? o.steps : 0;
     double wall = 0.0, collide = 0.0, highest = -INFINITY, stretch = 0.0;
     int64_t substeps = 0;
-    int landed = -1, finite = 1, worst_intersections = 0, last_intersections = 0;
+    int landed = -1, finite = 1, worst_intersections = 0, last_intersections = 0, last_collider = 0;
+    int64_t failsafe = 0;
     for (int f = 0; f < o.frames; ++f) {
         if (s.deforming) {
             bend_tube(&s.collider_mesh, (double)(f + 1) / o.frames, bent);
@@ -300,6 +313,7 @@ int main(int argc, char **argv)
         }
         wc_step_stats stats = wc_world_get_stats(s.world);
         collide += stats.collide_seconds;
+        failsafe += stats.failsafe_particles;
         substeps += wc_world_last_substeps(s.world);
         bench_check(wc_cloth_get_positions(s.world, s.cloth, xyz, n), s.world, "positions");
         bench_check(wc_cloth_get_contacts(s.world, s.cloth, contact, NULL, n), s.world, "contacts");
@@ -314,6 +328,7 @@ int main(int argc, char **argv)
             wc_intersection_counts k;
             bench_check(wc_world_count_intersections(s.world, &k), s.world, "intersections");
             last_intersections = k.cloth_cloth + k.cloth_collider;
+            last_collider = k.cloth_collider;
             if (last_intersections > worst_intersections) worst_intersections = last_intersections;
         }
     }
@@ -324,12 +339,14 @@ int main(int argc, char **argv)
            "\"frames\": %d, \"threads\": %d, \"ms_per_frame\": %.3f, \"collide_ms_per_frame\": %.3f, "
            "\"substeps_per_frame\": %.2f, \"intersections_last\": %d, \"intersections_worst\": %d, "
            "\"landed_frame\": %d, \"start_height\": %.4f, \"highest_after_landing\": %.4f, "
-           "\"longest_link\": %.4f, \"finite\": %d}\n",
+           "\"longest_link\": %.4f, \"finite\": %d, \"cloth_collider_last\": %d, "
+           "\"failsafe_last_substeps\": %lld}\n",
            o.scene, wc_version_string(), o.integrator, o.wet, o.self, (int)n,
            (int)s.collider_mesh.triangle_count, o.thickness, frames_done, o.threads,
            1e3 * wall / frames_done, 1e3 * collide / frames_done, (double)substeps / frames_done,
            last_intersections, worst_intersections, landed, s.start_height,
-           landed >= 0 ? highest : s.start_height, stretch, finite);
+           landed >= 0 ? highest : s.start_height, stretch, finite, last_collider,
+           (long long)failsafe);
     wc_world_destroy(s.world);
     free(pairs), free(rest), free(xyz), free(bent), free(contact);
     free(s.collider_mesh.v), free(s.collider_mesh.t);

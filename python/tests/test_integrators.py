@@ -34,7 +34,7 @@ def test_unknown_integrator_names_the_field():
 
 def test_scene_integrator_field():
     base = {"cloths": [{"grid": {"nu": 3, "nv": 3}}]}
-    assert scene.from_dict(base, "test.json", ".").integrator == "verlet"
+    assert scene.from_dict(base, "test.json", ".").integrator == "implicit"
     s = scene.from_dict(dict(base, integrator="implicit"), "test.json", ".")
     assert s.integrator == "implicit"
     with pytest.raises(scene.SceneError, match=r"integrator: expected one of"):

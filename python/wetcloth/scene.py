@@ -330,7 +330,7 @@ def from_dict(data, source, base_dir):
     s.substeps = r.integer("substeps", 0, minimum=0, maximum=10 ** 7)
     s.threads = r.integer("threads", 0, minimum=0, maximum=1024)
     s.gravity = r.vector("gravity", 3, [0.0, 0.0, -9.81])
-    s.integrator = r.string("integrator", "verlet", choices=["verlet", "xpbd", "implicit"])
+    s.integrator = r.string("integrator", "implicit", choices=["verlet", "xpbd", "implicit"])
     # None: the library's default
     s.implicit_tolerance = r.number("implicit_tolerance", None, minimum=0.0, maximum=1000.0)
     s.start_frame = r.number("start_frame", 1.0)
