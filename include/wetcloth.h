@@ -42,7 +42,7 @@ extern "C" {
 
 /// Version of this header. wc_version() gives the library's at run time.
 #define WC_VERSION_MAJOR 0
-#define WC_VERSION_MINOR 1
+#define WC_VERSION_MINOR 2
 #define WC_VERSION_PATCH 0
 /// Single number: major * 10000 + minor * 100 + patch.
 #define WC_VERSION (WC_VERSION_MAJOR * 10000 + WC_VERSION_MINOR * 100 + WC_VERSION_PATCH)

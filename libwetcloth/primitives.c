@@ -2,52 +2,35 @@
 
 #include <math.h>
 
-static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+#include "vec3.h"
 
-static void sub(const double a[3], const double b[3], double out[3])
-{
-    out[0] = a[0] - b[0], out[1] = a[1] - b[1], out[2] = a[2] - b[2];
-}
-
-static void cross(const double a[3], const double b[3], double out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static void lerp(const double a[3], const double b[3], double t, double out[3])
-{
-    for (int k = 0; k < 3; ++k) out[k] = a[k] + (b[k] - a[k]) * t;
-}
-
-void wc_triangle_normal(const double a[3], const double b[3], const double c[3], double n[3])
+void wci_triangle_normal(const double a[3], const double b[3], const double c[3], double n[3])
 {
     double u[3], v[3];
-    sub(b, a, u);
-    sub(c, a, v);
-    cross(u, v, n);
-    double len = sqrt(dot(n, n));
+    sub3(b, a, u);
+    sub3(c, a, v);
+    cross3(u, v, n);
+    double len = sqrt(dot3(n, n));
     for (int k = 0; k < 3; ++k) n[k] = len > 0.0 ? n[k] / len : 0.0;
 }
 
 /* Ericson, Real-Time Collision Detection, 5.1.5: Voronoi regions of the
  * triangle's vertices, edges and face, in that order. */
-double wc_point_triangle_closest(const double p[3], const double a[3], const double b[3],
+double wci_point_triangle_closest(const double p[3], const double a[3], const double b[3],
                                  const double c[3], double bary[3])
 {
     double ab[3], ac[3], ap[3], bp[3], cp[3], q[3];
-    sub(b, a, ab);
-    sub(c, a, ac);
-    sub(p, a, ap);
-    double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    sub3(b, a, ab);
+    sub3(c, a, ac);
+    sub3(p, a, ap);
+    double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
     if (d1 <= 0.0 && d2 <= 0.0) {
         bary[0] = 1.0, bary[1] = 0.0, bary[2] = 0.0;
     } else {
-        sub(p, b, bp);
-        double d3 = dot(ab, bp), d4 = dot(ac, bp);
-        sub(p, c, cp);
-        double d5 = dot(ab, cp), d6 = dot(ac, cp);
+        sub3(p, b, bp);
+        double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+        sub3(p, c, cp);
+        double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
         double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
         if (d3 >= 0.0 && d4 <= d3) {
             bary[0] = 0.0, bary[1] = 1.0, bary[2] = 0.0;
@@ -70,21 +53,21 @@ double wc_point_triangle_closest(const double p[3], const double a[3], const dou
         }
     }
     for (int k = 0; k < 3; ++k) q[k] = bary[0] * a[k] + bary[1] * b[k] + bary[2] * c[k];
-    sub(p, q, q);
-    return dot(q, q);
+    sub3(p, q, q);
+    return dot3(q, q);
 }
 
 static double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
 
 /* Ericson 5.1.9, with the parallel and degenerate cases handled. */
-double wc_segment_segment_closest(const double p0[3], const double p1[3], const double q0[3],
+double wci_segment_segment_closest(const double p0[3], const double p1[3], const double q0[3],
                                   const double q1[3], double *s_out, double *t_out)
 {
     double d1[3], d2[3], r[3];
-    sub(p1, p0, d1);
-    sub(q1, q0, d2);
-    sub(p0, q0, r);
-    double a = dot(d1, d1), e = dot(d2, d2), f = dot(d2, r);
+    sub3(p1, p0, d1);
+    sub3(q1, q0, d2);
+    sub3(p0, q0, r);
+    double a = dot3(d1, d1), e = dot3(d2, d2), f = dot3(d2, r);
     double s, t;
     if (a <= 0.0 && e <= 0.0) {
         s = t = 0.0;
@@ -92,12 +75,12 @@ double wc_segment_segment_closest(const double p0[3], const double p1[3], const 
         s = 0.0;
         t = clamp01(f / e);
     } else {
-        double c = dot(d1, r);
+        double c = dot3(d1, r);
         if (e <= 0.0) {
             t = 0.0;
             s = clamp01(-c / a);
         } else {
-            double b = dot(d1, d2), denom = a * e - b * b;
+            double b = dot3(d1, d2), denom = a * e - b * b;
             s = denom > 0.0 ? clamp01((b * f - c * e) / denom) : 0.0;
             t = (b * s + f) / e;
             if (t < 0.0) {
@@ -110,12 +93,12 @@ double wc_segment_segment_closest(const double p0[3], const double p1[3], const 
         }
     }
     double x[3], y[3];
-    lerp(p0, p1, s, x);
-    lerp(q0, q1, t, y);
-    sub(x, y, x);
+    lerp3(p0, p1, s, x);
+    lerp3(q0, q1, t, y);
+    sub3(x, y, x);
     *s_out = s;
     *t_out = t;
-    return dot(x, x);
+    return dot3(x, x);
 }
 
 /* Coefficients of f(t) = A(t) . (B(t) x C(t)), with A, B, C linear in t:
@@ -125,15 +108,15 @@ static void triple_product_cubic(const double A0[3], const double A1[3], const d
                                  double f[4])
 {
     double bc0[3], bc1a[3], bc1b[3], bc1[3], bc2[3];
-    cross(B0, C0, bc0);
-    cross(B0, C1, bc1a);
-    cross(B1, C0, bc1b);
+    cross3(B0, C0, bc0);
+    cross3(B0, C1, bc1a);
+    cross3(B1, C0, bc1b);
     for (int k = 0; k < 3; ++k) bc1[k] = bc1a[k] + bc1b[k];
-    cross(B1, C1, bc2);
-    f[0] = dot(A0, bc0);
-    f[1] = dot(A1, bc0) + dot(A0, bc1);
-    f[2] = dot(A1, bc1) + dot(A0, bc2);
-    f[3] = dot(A1, bc2);
+    cross3(B1, C1, bc2);
+    f[0] = dot3(A0, bc0);
+    f[1] = dot3(A1, bc0) + dot3(A0, bc1);
+    f[2] = dot3(A1, bc1) + dot3(A0, bc2);
+    f[3] = dot3(A1, bc2);
 }
 
 static double cubic_at(const double f[4], double t) { return ((f[3] * t + f[2]) * t + f[1]) * t + f[0]; }
@@ -189,26 +172,26 @@ static int cubic_roots01(const double f[4], double roots[3])
     return count;
 }
 
-int wc_ccd_point_triangle(const double p0[3], const double p1[3], const double a0[3],
+int wci_ccd_point_triangle(const double p0[3], const double p1[3], const double a0[3],
                           const double a1[3], const double b0[3], const double b1[3],
                           const double c0[3], const double c1[3], double tolerance, double *t_out,
                           double bary[3])
 {
     /* Everything relative to a: A = p - a, B = b - a, C = c - a. */
     double A0[3], A1[3], B0[3], B1[3], C0[3], C1[3], tmp[3];
-    sub(p0, a0, A0);
-    sub(b0, a0, B0);
-    sub(c0, a0, C0);
-    sub(p1, a1, tmp), sub(tmp, A0, A1);
-    sub(b1, a1, tmp), sub(tmp, B0, B1);
-    sub(c1, a1, tmp), sub(tmp, C0, C1);
+    sub3(p0, a0, A0);
+    sub3(b0, a0, B0);
+    sub3(c0, a0, C0);
+    sub3(p1, a1, tmp), sub3(tmp, A0, A1);
+    sub3(b1, a1, tmp), sub3(tmp, B0, B1);
+    sub3(c1, a1, tmp), sub3(tmp, C0, C1);
     double f[4], roots[3];
     triple_product_cubic(A0, A1, B0, B1, C0, C1, f);
     int n = cubic_roots01(f, roots);
     for (int i = 0; i < n; ++i) {
         double t = roots[i], p[3], a[3], b[3], c[3];
-        lerp(p0, p1, t, p), lerp(a0, a1, t, a), lerp(b0, b1, t, b), lerp(c0, c1, t, c);
-        if (wc_point_triangle_closest(p, a, b, c, bary) <= tolerance * tolerance) {
+        lerp3(p0, p1, t, p), lerp3(a0, a1, t, a), lerp3(b0, b1, t, b), lerp3(c0, c1, t, c);
+        if (wci_point_triangle_closest(p, a, b, c, bary) <= tolerance * tolerance) {
             *t_out = t;
             return 1;
         }
@@ -216,26 +199,26 @@ int wc_ccd_point_triangle(const double p0[3], const double p1[3], const double a
     return 0;
 }
 
-int wc_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
+int wci_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
                      const double q1[3], const double r0[3], const double r1[3],
                      const double s0[3], const double s1[3], double tolerance, double *t_out,
                      double *u, double *v)
 {
     /* Coplanar when (r - p) . ((q - p) x (s - r)) = 0. */
     double A0[3], A1[3], B0[3], B1[3], C0[3], C1[3], tmp[3];
-    sub(r0, p0, A0);
-    sub(q0, p0, B0);
-    sub(s0, r0, C0);
-    sub(r1, p1, tmp), sub(tmp, A0, A1);
-    sub(q1, p1, tmp), sub(tmp, B0, B1);
-    sub(s1, r1, tmp), sub(tmp, C0, C1);
+    sub3(r0, p0, A0);
+    sub3(q0, p0, B0);
+    sub3(s0, r0, C0);
+    sub3(r1, p1, tmp), sub3(tmp, A0, A1);
+    sub3(q1, p1, tmp), sub3(tmp, B0, B1);
+    sub3(s1, r1, tmp), sub3(tmp, C0, C1);
     double f[4], roots[3];
     triple_product_cubic(A0, A1, B0, B1, C0, C1, f);
     int n = cubic_roots01(f, roots);
     for (int i = 0; i < n; ++i) {
         double t = roots[i], p[3], q[3], r[3], s[3];
-        lerp(p0, p1, t, p), lerp(q0, q1, t, q), lerp(r0, r1, t, r), lerp(s0, s1, t, s);
-        if (wc_segment_segment_closest(p, q, r, s, u, v) <= tolerance * tolerance) {
+        lerp3(p0, p1, t, p), lerp3(q0, q1, t, q), lerp3(r0, r1, t, r), lerp3(s0, s1, t, s);
+        if (wci_segment_segment_closest(p, q, r, s, u, v) <= tolerance * tolerance) {
             *t_out = t;
             return 1;
         }
@@ -243,7 +226,7 @@ int wc_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
     return 0;
 }
 
-void wc_sym3_inverse(const double m[6], double out[6])
+void wci_sym3_inverse(const double m[6], double out[6])
 {
     double c0 = m[3] * m[5] - m[4] * m[4], c1 = m[2] * m[4] - m[1] * m[5],
            c2 = m[1] * m[4] - m[2] * m[3];

@@ -444,7 +444,7 @@ static void drape_frames(wc_integrator integrator, int32_t substeps, double *out
     wc_world_destroy(w);
 }
 
-/* Issue 8's error: RMS over particles and frames of the distance to the same
+/* The project's error protocol: RMS over particles and frames of the distance to the same
  * integrator at 8x the substeps, / 1 m. */
 static double drape_error(wc_integrator integrator, int32_t substeps)
 {
@@ -655,7 +655,7 @@ static void tolerance(void)
         CHECK(loose < exact, "tolerance %g: %lld iterations, to round-off %lld", tolerances[k],
               (long long)loose, (long long)exact);
         /* The 65^2 cloth's solve gets the coarse levels' correction (added
-         * in implicit.c's own pass, not through wc_multigrid_add_correction,
+         * in implicit.c's own pass, not through wci_multigrid_add_correction,
          * which test_multigrid checks): 100 iterations to round-off with it,
          * 458 with block-Jacobi alone (measured with the correction taken
          * out), so a solve that lost it fails this bound of 200. */

@@ -586,7 +586,7 @@ typedef struct spike_result {
 /* A small cloth (5 x 5, 0.2 m) slides at 1 m/s over the tip of a tall, thin
  * pyramid (tip at the origin, base 0.1 m wide 0.5 m below): the only
  * contact is the collider's tip vertex inside a cloth triangle, which the
- * feature pass (collide_features.c) answers; the cloth's particles stay far
+ * feature pass (collider_contacts.c) answers; the cloth's particles stay far
  * from the pyramid's faces. Soaked (w = 1), no adhesion (whose pull would
  * also raise the Coulomb friction), wet friction q as given; 0.1 s. */
 static spike_result spike_run(double q)
@@ -699,7 +699,7 @@ static self_result self_run(double wetness)
             const wc_cloth *c = w->cloths[cl];
             double fx[N], fy[N], fz[N];
             memset(fx, 0, sizeof fx), memset(fy, 0, sizeof fy), memset(fz, 0, sizeof fz);
-            wc_wet_self_adhesion(c, fx, fy, fz);
+            wci_wet_self_adhesion(c, fx, fy, fz);
             r.pairs = c->adhesive_count;
             for (int i = 0; i < N; ++i) {
                 r.force_sum[0] += fx[i], r.force_sum[1] += fy[i], r.force_sum[2] += fz[i];

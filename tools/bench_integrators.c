@@ -148,7 +148,7 @@ static run_result run(const options *o, int size, int self, int integrator, int 
     return r;
 }
 
-/* Issue 8's error: RMS distance over particles and frames / cloth size (1 m). */
+/* The project's error protocol: RMS distance over particles and frames / cloth size (1 m). */
 static double rms_error(const run_result *a, const run_result *b)
 {
     if (a->failed || b->failed) return NAN;

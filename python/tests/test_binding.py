@@ -172,7 +172,7 @@ def test_grid_layout():
 
 
 def test_free_fall_matches_closed_form():
-    # Verlet is exact for constant acceleration (SPEC 1.4)
+    # Verlet is exact for constant acceleration (docs/model.md, Integration)
     g = -9.81
     with World(gravity=(0.0, 0.0, g)) as w:
         c = w.add_grid_cloth(4, 4, center=(0.0, 0.0, 2.0), material=Material(air_drag=0.0))

@@ -4,7 +4,7 @@ library load and simulate the way the installed extension loads them
 (Blender installs the wheel, then the add-on imports its `wetcloth`
 subpackage, which loads the library beside it).
 
-    WC_ADDON_ZIP=dist/wetcloth-0.1.0-windows_x64.zip python -m pytest test_extension_zip.py
+    WC_ADDON_ZIP=dist/wetcloth-0.2.0-windows_x64.zip python -m pytest test_extension_zip.py
 
 scripts/test-windows.sh runs it in Windows' CPython under wine (ctest
 python_extension_zip of the Windows build). The Linux zip is tested inside

@@ -1,4 +1,4 @@
-"""Integrator choice (issue 7) through the binding and scene files."""
+"""Integrator choice through the binding and scene files."""
 import numpy as np
 import pytest
 

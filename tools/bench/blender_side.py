@@ -4,7 +4,7 @@ Run by report.py under the Python that has bpy 4.5 (.venv-blender), with
 PYTHONPATH giving the wetcloth package (and cffi) and WETCLOTH_LIBRARY the
 library. Prints a markdown section; --json writes the figures.
 
-Scene (Table 3.2's, as in NOTES): an n x n grid cloth 1 m wide, 0.6 m above
+Scene (the thesis' Table 3.2): an n x n grid cloth 1 m wide, 0.6 m above
 the 114-vertex UV sphere (16 x 8, radius 0.3 m), 24 fps. Blender: the Cloth
 modifier with its defaults and quality 5 (5 steps per frame), the sphere with
 a Collision modifier, self-collision on or off; the frames are evaluated in
@@ -14,7 +14,7 @@ thread for ours (Blender uses its own thread pool). The materials are not
 the same (Blender's defaults against our cotton): the ratio compares what a
 user gets from each with default settings on this scene.
 
-Frames: 48 up to 20 x 20, 24 up to 60 x 60 (as NOTES measured Blender),
+Frames: 48 up to 20 x 20, 24 up to 60 x 60,
 12 beyond. What makes the large sizes slow is our error's reference, not
 Blender nor our run: at 101 x 101 our default (Verlet, automatic substeps)
 takes ~600 substeps per frame and the reference 8x that, ~4,800 steps of a

@@ -6,7 +6,11 @@ Run it with the Python that has bpy (4.5):
 
     /work/main/.venv-blender/bin/python tools/bench/contacts_side.py \\
         --build build --base ../wt-contacts-base/build [--reps 2] \\
-        [--scenes thesis,sphere64,...] [--frames 24] [--sweep 2,5,10,20] [--json out.json]
+        [--scenes thesis,sphere64+xpbd12,...] [--frames 24] [--sweep 2,5,10,20] [--json out.json]
+
+A scene name takes flags after "+": wet (soaked), self (self-collision),
+xpbd12 (both builds with XPBD at 12 steps per frame instead of each one's
+default).
 
 Ours: build/tools/bench_contacts, once with this build's library and once
 with --base's (LD_LIBRARY_PATH; the program uses the public API only, so
@@ -131,6 +135,20 @@ def ours(program, library, scene, frames, extra=(), out=None):
     return row
 
 
+def base_library_dir(program, base):
+    """A folder in which the base build's library answers to the name the
+    program was linked against: the SONAME carries the minor version
+    (libwetcloth.so.0.2), which the build before the contact stage does not
+    have. The program uses only functions and struct fields that both have."""
+    real = os.path.realpath(os.path.join(base, "libwetcloth.so"))
+    needed = subprocess.run(["readelf", "-d", program], capture_output=True, text=True).stdout
+    names = {"libwetcloth.so"} | {w.strip("[]") for w in needed.split() if w.startswith("[libwetcloth")}
+    folder = tempfile.mkdtemp(prefix="wc-base-lib-")
+    for name in names:
+        os.symlink(real, os.path.join(folder, name))
+    return folder
+
+
 def read_positions(path, n):
     a = np.fromfile(path, dtype=np.float64)
     return a.reshape(-1, n, 3)
@@ -231,8 +249,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
     ap.add_argument("--base", help="build folder of the commit before (its libwetcloth.so)")
-    ap.add_argument("--scenes", default="thesis,thesis+self,sphere64,sphere176,soaked,soaked+wet,"
-                                        "cylinder,cylinder+wet")
+    ap.add_argument("--scenes", default="thesis,thesis+self,sphere64,sphere64+xpbd12,sphere176,"
+                                        "sphere176+xpbd12,soaked,soaked+wet,cylinder,cylinder+wet")
     ap.add_argument("--frames", type=int, default=24)
     ap.add_argument("--reps", type=int, default=2)
     ap.add_argument("--sweep", default="2,5,10,20", help="Blender qualities for the error sweep")
@@ -244,7 +262,7 @@ def main():
     a = ap.parse_args()
     program = os.path.join(a.build, "tools", "bench_contacts")
     build_lib = os.path.abspath(a.build)
-    base_lib = os.path.abspath(a.base) if a.base else None
+    base_lib = base_library_dir(program, a.base) if a.base else None
     sweep = [int(q) for q in a.sweep.split(",") if q]
     tmp = tempfile.mkdtemp(prefix="wc-contacts-")
     print(f"load average before: {' '.join(open('/proc/loadavg').read().split()[:3])}")
@@ -255,6 +273,10 @@ def main():
         wet, self_c = int("wet" in flags), int("self" in flags)
         n, width, height, spec, deforming = SCENES[scene]
         extra = [f"wet={wet}", f"self={self_c}", "thickness=0.02", "friction=0.5", "threads=1"]
+        # +xpbd12: both builds at the same setting (XPBD, 12 steps per frame),
+        # so that the collision cost compares like with like
+        if "xpbd12" in flags:
+            extra += ["integrator=xpbd", "steps=12"]
         new_runs, base_runs = [], []
         for rep in range(a.reps):
             if base_lib:

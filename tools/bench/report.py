@@ -496,6 +496,37 @@ def blender(out, quick, python, lines, sizes=None):
         return json.load(f)
 
 
+def contacts(out, quick, python, build, base, lines):
+    """The contact stage's scenes (tools/bench/contacts_side.py): this build,
+    the build before the contact stage (--contacts-base) and Blender."""
+    lines += ["## The contact stage", ""]
+    if not python or not os.path.exists(python):
+        lines += [f"Skipped: no Python with bpy ({python}).", ""]
+        return None
+    cmd = [python, os.path.join(HERE, "contacts_side.py"), "--build", build,
+           "--json", os.path.join(out, "contacts.json")]
+    if base:
+        cmd += ["--base", base, "--base-frames", "12"]
+    if quick:
+        cmd += ["--scenes", "thesis", "--frames", "4", "--reps", "1", "--sweep", "2"]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise SystemExit("contacts_side.py failed:\n" + r.stdout[-3000:] + r.stderr[-3000:])
+    lines += [
+        "Grid cloths falling onto mesh colliders with Blender's default collider thickness (0.02 m) "
+        "and friction 0.5, 24 frames of 1/24 s, 1 thread for ours (Blender uses its own thread "
+        "pool on the same cores); each library at its own default integrator and steps unless the "
+        "scene says +xpbd12 (both at XPBD, 12 steps per frame). \"before\" is the build of the "
+        "commit before the contact stage, run on the first 12 frames (falling and landing). Error: "
+        "RMS over particles and frames of the distance to the same setting at 8x the steps, / the "
+        "cloth's width; Blender's against its quality 40. Ranges are over alternated runs. Command: "
+        f"`{' '.join(os.path.relpath(c, ROOT) if os.path.isabs(c) and c.startswith(ROOT) else c for c in cmd[1:])}` "
+        "(with the Python that has bpy).", ""]
+    lines += r.stdout.rstrip().splitlines() + [""]
+    with open(os.path.join(out, "contacts.json")) as f:
+        return json.load(f)
+
+
 def table_3_2(program, quick, lines):
     lines += ["## The thesis' Table 3.2 next to ours", ""]
     if not program or not os.path.exists(program):
@@ -568,7 +599,9 @@ def main():
     ap.add_argument("--only", default="", help="comma-separated sections to run (the others' "
                     "parts already in --out are kept)")
     ap.add_argument("--skip", default="", help="comma-separated sections to skip: "
-                    "speed,closed,scaling,blender,table,hard")
+                    "speed,closed,scaling,blender,table,hard,other,contacts")
+    ap.add_argument("--contacts-base", help="build folder of the commit before the contact "
+                    "stage, for the contacts section's \"before\" columns")
     a = ap.parse_args()
     skip = set(filter(None, a.skip.split(",")))
     os.makedirs(a.out, exist_ok=True)
@@ -603,6 +636,7 @@ def main():
         ("table", lambda L: table_3_2(a.bench_collide, a.quick, L)),
         ("hard", lambda L: hard_cases(a.hard_cases, L) if not a.quick else None),
         ("other", lambda L: other_programs(a.build, a.quick, L)),
+        ("contacts", lambda L: contacts(a.out, a.quick, a.blender_python, a.build, a.contacts_base, L)),
     ]
     only = set(filter(None, a.only.split(",")))
     for k, (name, fn) in enumerate(sections):

@@ -4,7 +4,7 @@ to change them:
 
     PYTHONPATH=build/python .venv/bin/python tools/scenes/make_scenes.py
 
-Each reproduces a figure of the thesis (SPEC section 6) with the setup of
+Each reproduces a figure of the thesis (chapter 3, its wet scenes) with the setup of
 the matching test in tests/test_wet.c.
 """
 

@@ -139,7 +139,7 @@ def test_zip_contents(addon_zip):
     with zipfile.ZipFile(addon_zip) as z:
         names = set(z.namelist())
         manifest = z.read("blender_manifest.toml").decode()
-    assert os.path.basename(addon_zip) == "wetcloth-0.1.0-linux_x64.zip"
+    assert os.path.basename(addon_zip) == "wetcloth-0.2.0-linux_x64.zip"
     for name in ("__init__.py", "bake.py", "ops.py", "props.py", "ui.py", "cache.py",
                  "stack.py", "fields.py", "outdated.py", "material.py", "presets.py",
                  "presets/wet_cloth/Cotton.py", "presets/wet_cloth/Towel.py",
@@ -164,7 +164,7 @@ def test_installed_through_extensions(installed):
     wc = bake_mod.load_wetcloth()
     assert wc.__name__ == MODULE + ".wetcloth"
     assert wc.library_path.startswith(os.path.dirname(installed.__file__))
-    assert wc.__version__ == "0.1.0"
+    assert wc.__version__ == "0.2.0"
     assert hasattr(bpy.types.Object, "wet_cloth")
     assert bpy.types.PHYSICS_PT_wet_cloth.bl_context == "physics"
     assert bpy.types.PHYSICS_PT_wet_cloth.bl_label == "Wet Cloth"
