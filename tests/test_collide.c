@@ -439,6 +439,72 @@ static uint64_t thick_drop_hash(int32_t threads)
     return h;
 }
 
+/* The soaked cloth of the contact stage's benchmark at a size a test can
+ * afford: a 2 m cloth (30 x 30) dropped from 1 m onto a 64 x 32 UV sphere of
+ * radius 0.5 m with Blender's default collider thickness (0.02 m), friction
+ * 0.5, at the default integrator and steps, for 1.5 s (it lands at about
+ * 0.32 s and has settled by the end). Stable means what the benchmark
+ * measures: no particle rises above its start height after landing (a
+ * pumping contact lifts flaps), the longest stretch link stays within 1.5x
+ * its rest length (a contact fighting the solve stretches links without
+ * bound: 6.7x was seen on this scene before the contact stage), and the
+ * checker finds no intersection at the end. Dry only: soaked, this scene
+ * still stretches links to about 1.6x at the default integrator
+ * (docs/model.md, Known gaps). */
+static void thick_sphere_stays_stable(double wetness)
+{
+    wc_world_def def = wc_world_def_default();
+    def.thread_count = 1;
+    wc_world *w = scene_world_from(&def);
+    static double v[3 * (2 + 31 * 64)];
+    static int32_t t[3 * 2 * 64 * 31];
+    int32_t nt, col, cl;
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertex_count = scene_uv_sphere(0.5, 64, 32, v, t, &nt);
+    d.vertices = v, d.triangles = t, d.triangle_count = nt, d.thickness = 0.02, d.friction = 0.5;
+    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = 30;
+    g.size_u = g.size_v = 2.0;
+    g.center[2] = 1.0;
+    g.wetness = wetness;
+    CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
+    int32_t n = wc_cloth_particle_count(w, cl);
+    int32_t links = wc_cloth_link_count(w, cl, WC_LINK_STRETCH);
+    double *x = malloc(3 * (size_t)n * sizeof *x), *rest = malloc((size_t)links * sizeof *rest);
+    int32_t *pairs = malloc(2 * (size_t)links * sizeof *pairs);
+    CHECK(x && rest && pairs, "out of memory");
+    if (!x || !rest || !pairs) return;
+    CHECK(wc_cloth_get_links(w, cl, WC_LINK_STRETCH, pairs, rest, links) == WC_OK, "links");
+    double highest = -1e300, longest = 0.0;
+    int landed = 0;
+    for (int f = 0; f < 36; ++f) {
+        advance_or_fail(w, 1.0 / 24, 0);
+        landed |= wc_world_get_stats(w).collider_contacts > 0;
+        CHECK(wc_cloth_get_positions(w, cl, x, n) == WC_OK, "positions");
+        for (int32_t k = 0; k < links; ++k) {
+            const double *a = x + 3 * (size_t)pairs[2 * k], *b = x + 3 * (size_t)pairs[2 * k + 1];
+            double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+            double stretch = sqrt(dx * dx + dy * dy + dz * dz) / rest[k];
+            if (stretch > longest) longest = stretch;
+        }
+        if (landed)
+            for (int32_t i = 0; i < n; ++i)
+                if (x[3 * (size_t)i + 2] > highest) highest = x[3 * (size_t)i + 2];
+    }
+    wc_intersection_counts ic;
+    CHECK(wc_world_count_intersections(w, &ic) == WC_OK, "checker");
+    printf("thick sphere, wetness %.0f: highest after landing %.4f m (start 1.0), longest link "
+           "%.3f x rest, intersections %d + %d\n", wetness, highest, longest, (int)ic.cloth_cloth,
+           (int)ic.cloth_collider);
+    CHECK(landed, "the cloth never reached the sphere");
+    CHECK(highest <= 1.0, "a particle rose to %.4f m, above its start height 1.0 m", highest);
+    CHECK(longest <= 1.5, "a link stretched to %.3f x its rest length", longest);
+    CHECK(ic.cloth_collider == 0, "%d cloth-collider intersections", (int)ic.cloth_collider);
+    free(x), free(rest), free(pairs);
+    wc_world_destroy(w);
+}
+
 static void determinism(void)
 {
     uint64_t h1 = sphere_drop_hash(1), h2 = sphere_drop_hash(2), h4 = sphere_drop_hash(4);
@@ -520,6 +586,8 @@ int main(void)
     thesis_scene();
     printf("(%.1f s) ", seconds() - t0);
     determinism();
+    printf("(%.1f s) ", seconds() - t0);
+    thick_sphere_stays_stable(0.0);
     printf("(%.1f s) ", seconds() - t0);
     filter_is_exact(WC_INTEGRATOR_VERLET, 0, "verlet");
     filter_is_exact(WC_INTEGRATOR_XPBD, 20, "xpbd, 20 steps per frame");
