@@ -4,7 +4,7 @@
 #include <omp.h>
 #endif
 
-int wc_thread_count(int requested)
+int wci_thread_count(int requested)
 {
 #ifdef _OPENMP
     return requested > 0 ? requested : omp_get_max_threads();
@@ -14,7 +14,7 @@ int wc_thread_count(int requested)
 #endif
 }
 
-int wc_parallel_for(int64_t n, int threads, wc_range_fn body, void *context)
+int wci_parallel_for(int64_t n, int threads, wc_range_fn body, void *context)
 {
     if (n <= 0) return 0;
 #ifdef _OPENMP

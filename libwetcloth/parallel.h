@@ -11,7 +11,7 @@
 #define WC_PARALLEL_MIN 4096
 
 /// Threads to use for a world's thread_count setting (0 = OpenMP default).
-int wc_thread_count(int requested);
+int wci_thread_count(int requested);
 
 /// Threads a loop of `work` iterations runs on: `threads` from
 /// WC_PARALLEL_MIN iterations up, one below.
@@ -21,7 +21,7 @@ static inline int wc_threads_for(int64_t work, int threads)
 }
 
 /// The body of a loop over the items [begin, end); returns nonzero to flag
-/// something (a non-finite value, say), which wc_parallel_for passes on.
+/// something (a non-finite value, say), which wci_parallel_for passes on.
 typedef int (*wc_range_fn)(void *context, int64_t begin, int64_t end);
 
 /// Runs body over the items [0, n): with threads > 1, in one contiguous
@@ -31,6 +31,6 @@ typedef int (*wc_range_fn)(void *context, int64_t begin, int64_t end);
 /// even when its if clause is false, and leaving it wakes the team with a
 /// futex system call: ~0.4 us per loop measured here, more than most loops
 /// of a 400-particle cloth cost, and a step runs several of them.
-int wc_parallel_for(int64_t n, int threads, wc_range_fn body, void *context);
+int wci_parallel_for(int64_t n, int threads, wc_range_fn body, void *context);
 
 #endif

@@ -54,7 +54,7 @@ static void copy_into(wc_particles *p, wc_cloth *c, size_t at)
     for (int k = 0; k < BYTES; ++k) memcpy(*wf.b[k] + at, *cf.b[k], n);
 }
 
-int wc_particles_add(wc_particles *p, wc_cloth *const *cloths, int32_t count)
+int wci_particles_add(wc_particles *p, wc_cloth *const *cloths, int32_t count)
 {
     int64_t total = 0;
     for (int32_t c = 0; c < count; ++c) total += cloths[c]->particle_count;
@@ -62,7 +62,7 @@ int wc_particles_add(wc_particles *p, wc_cloth *const *cloths, int32_t count)
     if (total > INT32_MAX || (uint64_t)total > SIZE_MAX / per) return 1;
     size_t n = (size_t)total;
     /* doubles first, then the int32 and byte arrays: each array aligned */
-    unsigned char *block = wc_alloc_array(n, per);
+    unsigned char *block = wci_alloc_array(n, per);
     if (!block) return 1;
     wc_particles q;
     memset(&q, 0, sizeof q);
@@ -88,16 +88,16 @@ int wc_particles_add(wc_particles *p, wc_cloth *const *cloths, int32_t count)
         }
     for (int32_t c = 0; c < count; ++c) {
         wc_cloth *cl = cloths[c];
-        if (!cl->in_world) wc_particles_free_own(cl);
+        if (!cl->in_world) wci_particles_free_own(cl);
         cl->in_world = 1;
         point(&q, cl);
     }
-    wc_free(p->block);
+    wci_free(p->block);
     *p = q;
     return 0;
 }
 
-void wc_particles_commit(wc_particles *p, wc_cloth *const *cloths, int32_t count)
+void wci_particles_commit(wc_particles *p, wc_cloth *const *cloths, int32_t count)
 {
     double *t;
     t = p->px, p->px = p->x, p->x = p->nx, p->nx = t;
@@ -106,7 +106,7 @@ void wc_particles_commit(wc_particles *p, wc_cloth *const *cloths, int32_t count
     for (int32_t c = 0; c < count; ++c) point(p, cloths[c]);
 }
 
-void wc_particles_view(wc_cloth *view, const wc_cloth *from)
+void wci_particles_view(wc_cloth *view, const wc_cloth *from)
 {
     fields vf = cloth_fields(view), ff = cloth_fields((wc_cloth *)from);
     for (int k = 0; k < DOUBLES; ++k) *vf.d[k] = *ff.d[k];
@@ -114,16 +114,16 @@ void wc_particles_view(wc_cloth *view, const wc_cloth *from)
     for (int k = 0; k < BYTES; ++k) *vf.b[k] = *ff.b[k];
 }
 
-void wc_particles_free_own(wc_cloth *c)
+void wci_particles_free_own(wc_cloth *c)
 {
     fields f = cloth_fields(c);
-    for (int k = 0; k < DOUBLES; ++k) wc_free(*f.d[k]), *f.d[k] = NULL;
-    for (int k = 0; k < INTS; ++k) wc_free(*f.i[k]), *f.i[k] = NULL;
-    for (int k = 0; k < BYTES; ++k) wc_free(*f.b[k]), *f.b[k] = NULL;
+    for (int k = 0; k < DOUBLES; ++k) wci_free(*f.d[k]), *f.d[k] = NULL;
+    for (int k = 0; k < INTS; ++k) wci_free(*f.i[k]), *f.i[k] = NULL;
+    for (int k = 0; k < BYTES; ++k) wci_free(*f.b[k]), *f.b[k] = NULL;
 }
 
-void wc_particles_free(wc_particles *p)
+void wci_particles_free(wc_particles *p)
 {
-    wc_free(p->block);
+    wci_free(p->block);
     memset(p, 0, sizeof *p);
 }

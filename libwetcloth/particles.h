@@ -10,7 +10,7 @@
  * then one contiguous range, and the group's combined cloth (cloth_group.c)
  * is a view of it rather than a copy.
  *
- * A cloth is made with arrays of its own (wc_cloth_create); joining a world
+ * A cloth is made with arrays of its own (wci_cloth_create); joining a world
  * moves them into the world's block. Arrays that exist only for some
  * materials or features (velocity scratch for damping and drag, wicking
  * scratch, soft pin slots, applied force fields) stay with the cloth. */
@@ -39,22 +39,22 @@ typedef struct wc_particles {
 /// block. Non-zero on out-of-memory or when the world would hold more than
 /// 2^31 - 1 particles, with the world's particles and every cloth as they
 /// were.
-int wc_particles_add(wc_particles *p, wc_cloth *const *cloths, int32_t count);
+int wci_particles_add(wc_particles *p, wc_cloth *const *cloths, int32_t count);
 
 /// After a successful step, for every cloth at once: the positions after
 /// the step become the current ones and the current ones the previous
 /// (px <- x <- nx <- px, a swap of the arrays), and every cloth's views
 /// follow.
-void wc_particles_commit(wc_particles *p, wc_cloth *const *cloths, int32_t count);
+void wci_particles_commit(wc_particles *p, wc_cloth *const *cloths, int32_t count);
 
 /// Gives a cloth the per-particle views of another, from the other's first
 /// particle on: how the cloth group's combined cloth sees its members'
 /// range.
-void wc_particles_view(wc_cloth *view, const wc_cloth *from);
+void wci_particles_view(wc_cloth *view, const wc_cloth *from);
 
 /// Frees the per-particle arrays a cloth still owns (not yet in a world).
-void wc_particles_free_own(wc_cloth *c);
+void wci_particles_free_own(wc_cloth *c);
 
-void wc_particles_free(wc_particles *p);
+void wci_particles_free(wc_particles *p);
 
 #endif
