@@ -446,7 +446,8 @@ typedef enum wc_contact_kind {
 
 /// Read-only structure-of-arrays view of one cloth's particles. The pointers
 /// stay valid until the next call that changes the world (a step, advance,
-/// set_positions, ...).
+/// adding a cloth, set_positions, ...): the world keeps all its cloths'
+/// particles in arrays of its own, which move when they grow.
 typedef struct wc_cloth_view {
     int32_t particle_count;
     /// Positions, m.

@@ -7,6 +7,7 @@
 #include "buckling.h"
 #include "collider_contacts.h"
 #include "implicit.h"
+#include "particles.h"
 #include "selfcollide.h"
 #include "status.h"
 #include "xpbd.h"
@@ -14,24 +15,17 @@
 void wci_cloth_destroy(wc_cloth *c)
 {
     if (!c) return;
-    double *arrays[] = {c->x,  c->y,  c->z,  c->px,      c->py,      c->pz,      c->nx,
-                        c->ny, c->nz, c->fx, c->fy,      c->fz,      c->vx,      c->vy,
-                        c->vz, c->mass, c->inv_mass, c->stretch_k, c->stretch_c, c->bend_r,
-                        c->bend_inv_rest, c->bend_coef,
-                        c->link_fx, c->link_fy, c->link_fz, c->pins.from, c->pins.to,
-                        c->normal_x, c->normal_y, c->normal_z, c->qx, c->qy, c->qz,
-                        c->wetness, c->wetness_next, c->pins.stiffness, c->air_velocity,
-                        c->external_force};
+    /* in a world, the per-particle arrays are the world's (particles.h) */
+    if (!c->in_world) wci_particles_free_own(c);
+    double *arrays[] = {c->vx, c->vy, c->vz, c->stretch_k, c->stretch_c, c->bend_r,
+                        c->bend_inv_rest, c->bend_coef, c->link_fx, c->link_fy, c->link_fz,
+                        c->pins.from, c->pins.to, c->wetness_next, c->pins.stiffness,
+                        c->air_velocity, c->external_force};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wci_free(arrays[i]);
     wci_free(c->link_start);
     wci_free(c->link_list);
-    wci_free(c->pin_slot);
     wci_free(c->soft_pin_slot);
     wci_free(c->pins.particle);
-    wci_free(c->contact);
-    wci_free(c->contact_prev);
-    wci_free(c->stuck);
-    wci_free(c->history_override);
     wci_free(c->self_touched);
     wci_free(c->adhesive_pairs);
     wci_free(c->adhesive_data);
@@ -313,10 +307,6 @@ wc_status wci_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const i
 
 void wci_cloth_commit(wc_cloth *c, double dt, int with_overrides)
 {
-    double *t;
-    t = c->px, c->px = c->x, c->x = c->nx, c->nx = t;
-    t = c->py, c->py = c->y, c->y = c->ny, c->ny = t;
-    t = c->pz, c->pz = c->z, c->z = c->nz, c->nz = t;
     if (with_overrides)
         for (int32_t i = 0; i < c->particle_count; ++i)
             if (c->history_override[i]) c->px[i] = c->qx[i], c->py[i] = c->qy[i], c->pz[i] = c->qz[i];

@@ -32,6 +32,12 @@ typedef struct wc_pins {
 
 typedef struct wc_cloth {
     int32_t particle_count;
+    /// Once the cloth is in a world (in_world), the per-particle arrays
+    /// below (positions, forces, masses, contacts, wetness, pin slots; see
+    /// particles.h for which) are views of the world's arrays from particle
+    /// `first` on; before, the cloth owns them.
+    int32_t first;
+    int in_world;
     /// Positions now, m.
     double *x, *y, *z;
     /// Positions one step ago. Before the first step (has_history == 0) they
@@ -153,9 +159,10 @@ wc_status wci_cloth_create(wc_cloth **out, const double *xyz, int32_t vertex_cou
 
 void wci_cloth_destroy(wc_cloth *cloth);
 
-/// Moves px/x/nx one step on after a successful step of length dt. With
-/// overrides, particles whose history_override is set get q as their
-/// previous position, which carries the velocity a collision gave them.
+/// After a successful step of length dt, once the world moved px/x/nx one
+/// step on (wci_particles_commit): with overrides, particles whose
+/// history_override is set get q as their previous position, which carries
+/// the velocity a collision gave them.
 void wci_cloth_commit(wc_cloth *cloth, double dt, int with_overrides);
 
 /// Derives masses, link constants and the stable step from the material and

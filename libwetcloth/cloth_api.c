@@ -7,6 +7,7 @@
 #include "buckling.h"
 #include "cloth.h"
 #include "material.h"
+#include "particles.h"
 #include "status.h"
 #include "world.h"
 
@@ -41,20 +42,34 @@ wc_grid_cloth_def wc_grid_cloth_def_default(void)
 
 static wc_status append_cloth(wc_world *w, wc_cloth *c, int32_t *out_cloth)
 {
+    /* both allocations before either is kept, so a failure changes nothing */
+    wc_cloth **list = w->cloths, **grown = NULL;
+    int32_t capacity = w->cloth_capacity;
     if (w->cloth_count == w->cloth_capacity) {
-        int32_t capacity = w->cloth_capacity ? 2 * w->cloth_capacity : 4;
-        wc_cloth **grown = wci_alloc_array((size_t)capacity, sizeof *grown);
+        capacity = w->cloth_capacity ? 2 * w->cloth_capacity : 4;
+        grown = wci_alloc_array((size_t)capacity, sizeof *grown);
         if (!grown) {
             wci_cloth_destroy(c);
             return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a cloth");
         }
         if (w->cloth_count) memcpy(grown, w->cloths, (size_t)w->cloth_count * sizeof *grown);
+        list = grown;
+    }
+    /* the world takes the cloth's per-particle arrays into its own */
+    list[w->cloth_count] = c;
+    if (wci_particles_add(&w->particles, list, w->cloth_count + 1)) {
+        list[w->cloth_count] = NULL;
+        wci_free(grown);
+        wci_cloth_destroy(c);
+        return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                       "out of memory adding a cloth (the world's particle arrays)");
+    }
+    if (grown) {
         wci_free(w->cloths);
         w->cloths = grown;
         w->cloth_capacity = capacity;
     }
     wci_cloth_set_integrator(c, w->def.integrator);
-    w->cloths[w->cloth_count] = c;
     *out_cloth = w->cloth_count++;
     return WC_OK;
 }

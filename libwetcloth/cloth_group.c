@@ -3,13 +3,10 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "invariant.h"
+#include "particles.h"
 #include "selfcollide.h"
 #include "wetness.h"
-
-/* The combined cloth's per-particle arrays that a step copies in and out.
- * The first OUT_DOUBLES are the answer (copied back), the rest only read;
- * likewise for the byte arrays. */
-enum { DOUBLE_FIELDS = 14, OUT_DOUBLES = 9, BYTE_FIELDS = 3, OUT_BYTES = 2 };
 
 struct wc_cloth_group {
     /// Members and their world indices.
@@ -27,8 +24,10 @@ struct wc_cloth_group {
     int32_t world_cloths;
     uint8_t *handled;
     /// The combined cloth: only what collision reads (see selfcollide.c).
-    /// Its adhesive pairs are the wet pairs between different members
-    /// (wetness.c), in combined numbering.
+    /// Its per-particle arrays are views of the world's, whose members are
+    /// one range (particles.h), set before each pass; it owns its
+    /// triangles, its self-collision state and its adhesive pairs, the wet
+    /// pairs between different members (wetness.c), in combined numbering.
     wc_cloth combined;
     /// Those pairs as wci_cloth_group_save found them, for
     /// wci_cloth_group_restore.
@@ -38,20 +37,6 @@ struct wc_cloth_group {
     /// Per member, for the adhesion between members.
     wc_wet_piece *pieces;
 };
-
-static void double_fields(wc_cloth *c, double **out[DOUBLE_FIELDS])
-{
-    double **f[DOUBLE_FIELDS] = {&c->nx, &c->ny, &c->nz, &c->normal_x, &c->normal_y, &c->normal_z,
-                                 &c->qx, &c->qy, &c->qz, &c->x, &c->y, &c->z, &c->inv_mass,
-                                 &c->wetness};
-    memcpy(out, f, sizeof f);
-}
-
-static void byte_fields(wc_cloth *c, uint8_t **out[BYTE_FIELDS])
-{
-    uint8_t **f[BYTE_FIELDS] = {&c->contact, &c->history_override, &c->contact_prev};
-    memcpy(out, f, sizeof f);
-}
 
 int wci_cloth_group_possible(wc_cloth *const *cloths, int32_t cloth_count)
 {
@@ -64,13 +49,6 @@ void wci_cloth_group_destroy(wc_cloth_group *g)
 {
     if (!g) return;
     wc_cloth *c = &g->combined;
-    double **d[DOUBLE_FIELDS];
-    uint8_t **b[BYTE_FIELDS];
-    double_fields(c, d);
-    byte_fields(c, b);
-    for (int k = 0; k < DOUBLE_FIELDS; ++k) wci_free(*d[k]);
-    for (int k = 0; k < BYTE_FIELDS; ++k) wci_free(*b[k]);
-    wci_free(c->pin_slot);
     wci_free(c->topology.triangles);
     wci_free(c->self_touched);
     wci_free(c->adhesive_pairs);
@@ -82,7 +60,7 @@ void wci_cloth_group_destroy(wc_cloth_group *g)
     wci_free(g);
 }
 
-/* Members, offsets and the combined cloth's arrays; 0 on out-of-memory. */
+/* Members, offsets and the combined cloth's triangles; 0 on out-of-memory. */
 static int allocate(wc_cloth_group *g, wc_cloth *const *cloths, int32_t cloth_count)
 {
     int32_t m = 0;
@@ -110,28 +88,24 @@ static int allocate(wc_cloth_group *g, wc_cloth *const *cloths, int32_t cloth_co
         ++k;
     }
     wc_cloth *comb = &g->combined;
-    size_t n = (size_t)g->first[m];
     comb->particle_count = g->first[m];
     comb->topology.triangle_count = g->first_triangle[m];
-    double **d[DOUBLE_FIELDS];
-    uint8_t **b[BYTE_FIELDS];
-    double_fields(comb, d);
-    byte_fields(comb, b);
-    int ok = 1;
-    for (int k = 0; k < DOUBLE_FIELDS; ++k) ok &= (*d[k] = wci_alloc_array(n, sizeof(double))) != NULL;
-    for (int k = 0; k < BYTE_FIELDS; ++k) ok &= (*b[k] = wci_alloc_array(n, 1)) != NULL;
-    comb->pin_slot = wci_alloc_array(n, sizeof *comb->pin_slot);
     comb->topology.triangles =
         wci_alloc_array(3 * (size_t)g->first_triangle[m], sizeof *comb->topology.triangles);
-    return ok && comb->pin_slot && comb->topology.triangles;
+    return comb->topology.triangles != NULL;
 }
 
 /* The combined cloth's triangles and rest shape (each self-colliding
  * member's own rest shape, so its pairs keep the thickness they had alone),
- * then its self-collision state. */
+ * then its self-collision state, which keeps its own copy of the rest
+ * shape: the positions given to it here are scratch. */
 static int build_combined(wc_cloth_group *g, wc_cloth *const *cloths)
 {
     wc_cloth *comb = &g->combined;
+    size_t total = (size_t)comb->particle_count;
+    double *rest_xyz = wci_alloc_array(3 * total, sizeof *rest_xyz);
+    if (!rest_xyz) return 0;
+    comb->x = rest_xyz, comb->y = rest_xyz + total, comb->z = rest_xyz + 2 * total;
     for (int32_t k = 0; k < g->count; ++k) {
         const wc_cloth *cl = cloths[g->member[k]];
         int32_t off = g->first[k], n = cl->particle_count;
@@ -149,6 +123,8 @@ static int build_combined(wc_cloth_group *g, wc_cloth *const *cloths)
     }
     wc_self_pieces pieces = {g->count, g->first, g->self, g->friction, g->wet_friction};
     comb->self = wci_self_state_create_pieces(comb, &pieces);
+    wci_free(rest_xyz);
+    comb->x = comb->y = comb->z = NULL;
     return comb->self != NULL;
 }
 
@@ -204,25 +180,19 @@ static int members_meet(const wc_cloth_group *g, wc_cloth *const *cloths, double
     return meet;
 }
 
-/* The members' state into the combined cloth (all fields) or the answer
- * back out (out = 1: the answer's fields only). */
-static void copy_state(wc_cloth_group *g, wc_cloth *const *cloths, int out)
+/* The combined cloth's per-particle arrays: the members' range of the
+ * world's (particles.h), which starts at the first member; with `on` 0, no
+ * arrays, so that nothing keeps pointers the next commit or added cloth
+ * moves. */
+static void view_members(wc_cloth_group *g, wc_cloth *const *cloths, int on)
 {
+    static const wc_cloth none;
     wc_cloth *comb = &g->combined;
-    double **cd[DOUBLE_FIELDS], **md[DOUBLE_FIELDS];
-    uint8_t **cb[BYTE_FIELDS], **mb[BYTE_FIELDS];
-    double_fields(comb, cd);
-    byte_fields(comb, cb);
-    for (int32_t k = 0; k < g->count; ++k) {
-        wc_cloth *cl = cloths[g->member[k]];
-        size_t off = (size_t)g->first[k], n = (size_t)cl->particle_count;
-        double_fields(cl, md);
-        byte_fields(cl, mb);
-        for (int f = 0; f < (out ? OUT_DOUBLES : DOUBLE_FIELDS); ++f)
-            memcpy(out ? *md[f] : *cd[f] + off, out ? *cd[f] + off : *md[f], n * sizeof(double));
-        for (int f = 0; f < (out ? OUT_BYTES : BYTE_FIELDS); ++f)
-            memcpy(out ? *mb[f] : *cb[f] + off, out ? *cb[f] + off : *mb[f], n);
-        if (!out) memcpy(comb->pin_slot + off, cl->pin_slot, n * sizeof *cl->pin_slot);
+    wci_particles_view(comb, on ? cloths[g->member[0]] : &none);
+    for (int32_t k = 0; k < g->count && on; ++k) {
+        const wc_cloth *cl = cloths[g->member[k]];
+        (void)cl;
+        WC_ASSERT(cl->x == comb->x + g->first[k] && cl->pin_slot == comb->pin_slot + g->first[k]);
     }
 }
 
@@ -345,16 +315,19 @@ wc_status wci_cloth_group_collide(wc_cloth_group *g, wc_cloth *const *cloths, do
         return WC_OK;
     }
     wci_self_state_set_friction(comb->self, g->friction, g->wet_friction);
-    copy_state(g, cloths, 0);
-    if (wci_self_collide(comb, dt, threads, stats)) return WC_ERROR_OUT_OF_MEMORY;
-    copy_state(g, cloths, 1);
-    for (int32_t k = 0; k < g->count; ++k) {
-        wc_cloth *cl = cloths[g->member[k]];
-        g->handled[g->member[k]] = 1;
-        /* its own candidates will be out of date when it next runs alone */
-        if (cl->self) wci_self_state_invalidate(cl->self);
+    view_members(g, cloths, 1);
+    wc_status s = wci_self_collide(comb, dt, threads, stats) ? WC_ERROR_OUT_OF_MEMORY : WC_OK;
+    if (!s) {
+        for (int32_t k = 0; k < g->count; ++k) {
+            wc_cloth *cl = cloths[g->member[k]];
+            g->handled[g->member[k]] = 1;
+            /* its own candidates will be out of date when it next runs alone */
+            if (cl->self) wci_self_state_invalidate(cl->self);
+        }
+        if (comb->wet_forces) s = hand_out_adhesion(g, cloths, h);
     }
-    return comb->wet_forces ? hand_out_adhesion(g, cloths, h) : WC_OK;
+    view_members(g, cloths, 0);
+    return s;
 }
 
 int wci_cloth_group_handled(const wc_cloth_group *g, int32_t cloth)

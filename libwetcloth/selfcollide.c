@@ -73,6 +73,7 @@
 #include "primitives.h"
 #include "response.h"
 #include "wetness.h"
+#include "invariant.h"
 #include "vec3.h"
 
 /* Response passes before the fail-safe. Each pass re-evaluates only what
@@ -553,6 +554,8 @@ wc_self_state *wci_self_state_create(const wc_cloth *c) { return wci_self_state_
 
 wc_self_state *wci_self_state_create_pieces(const wc_cloth *c, const wc_self_pieces *pieces)
 {
+    WC_ASSERT(c->topology.triangles != NULL || c->topology.triangle_count == 0);
+    WC_ASSERT(c->particle_count > 0);
     wc_self_state *s = wci_alloc_array(1, sizeof *s);
     if (!s) return NULL;
     size_t n = (size_t)c->particle_count, nt = (size_t)c->topology.triangle_count;

@@ -11,8 +11,8 @@
 /// Per-cloth buffers (broadphase grid, edge list, scratch). Opaque.
 typedef struct wc_self_state wc_self_state;
 
-/// Allocates the state for a cloth (its topology must be built). NULL on
-/// out-of-memory.
+/// Allocates the state for a cloth (its topology must be built: asserted).
+/// NULL on out-of-memory.
 wc_self_state *wci_self_state_create(const wc_cloth *cloth);
 void wci_self_state_destroy(wc_self_state *state);
 

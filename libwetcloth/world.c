@@ -122,6 +122,7 @@ void wc_world_destroy(wc_world *w)
     for (int32_t i = 0; i < w->cloth_count; ++i) wci_cloth_destroy(w->cloths[i]);
     for (int32_t i = 0; i < w->collider_count; ++i) wci_collider_destroy(w->colliders[i]);
     wci_free(w->cloths);
+    wci_particles_free(&w->particles);
     wci_free(w->colliders);
     wci_contact_backup_destroy(&w->backup);
     wci_cloth_group_destroy(w->group);
@@ -143,6 +144,27 @@ wc_cloth *wci_world_find_cloth(const wc_world *w, int32_t cloth, const char *cal
 /* ------------------------------------------------------------------------ */
 /* Stepping                                                                  */
 /* ------------------------------------------------------------------------ */
+
+/* What the stages of one step share. The per-particle state they read and
+ * write is the world's (particles.h), reached through each cloth's views;
+ * only the commit moves those arrays. */
+typedef struct step_context {
+    /// Length of the step, s.
+    double dt;
+    /// Part of what is left of the advance that this step covers, and how
+    /// many steps of it follow this one (colliders move by it).
+    double share;
+    int32_t steps_left;
+    /// Fractions of the way to their targets the pins are at when the step
+    /// starts and when it ends, and where the soft pins pull toward while
+    /// forces are evaluated: the start, or the end for backward Euler.
+    double pin_start, pin_fraction, goal_fraction;
+    int threads;
+    /// Whether the step has collisions at all (colliders, or a cloth that
+    /// collides with itself or with others): then the commit applies the
+    /// collision response's history overrides.
+    int colliding;
+} step_context;
 
 static int any_cloth_collision(const wc_world *w)
 {
@@ -187,10 +209,12 @@ static wc_status guard_steps(wc_world *w, double dt, int threads)
  * then answers to the relative motion. `share` is the part of what is left
  * of the advance that this step covers, `steps_left` how many steps of it
  * follow this one. */
-static wc_status collide(wc_world *w, double dt, double share, int32_t steps_left, int threads)
+static wc_status collide(wc_world *w, const step_context *ctx)
 {
+    double dt = ctx->dt;
+    int threads = ctx->threads;
     for (int32_t k = 0; k < w->collider_count; ++k)
-        if (wci_collider_begin_step(w->colliders[k], share))
+        if (wci_collider_begin_step(w->colliders[k], ctx->share))
             return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory indexing collider %d; the world keeps its last good state",
                            (int)k);
@@ -207,7 +231,7 @@ static wc_status collide(wc_world *w, double dt, double share, int32_t steps_lef
                            "out of memory for the collision buffers of cloth %d; the world "
                            "keeps its last good state", (int)c);
         if (wci_collider_contacts_resolve(cl, cl->collider_contacts, w->colliders, w->collider_count,
-                                         steps_left, threads, &w->stats))
+                                         ctx->steps_left, threads, &w->stats))
             return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory indexing cloth %d for collisions; the world keeps its "
                            "last good state", (int)c);
@@ -272,69 +296,103 @@ static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_f
                    "last good state", (int)c);
 }
 
-/* One step of the whole world, top to bottom: forces (with the applied
- * forces and the wet pull of the last step's contacts), integration,
- * collisions (with colliders, then each cloth with itself; wet friction
- * acts in their response), the wet response (stuck particles), the commit,
- * and the wetness dynamics. Nothing is committed unless every cloth's new
- * state is finite, so a failed step leaves the world exactly as it was.
- * The pins are at pin_start of the way to their targets when the step
- * starts and at pin_fraction when it ends. */
-static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_left,
-                            double pin_start, double pin_fraction)
+/* Forces, with the applied forces and the wet pull of the last step's
+ * contacts, then the wet cloths sticking to each other (after every
+ * cloth's own forces). */
+static void forces_stage(wc_world *w, const step_context *ctx)
 {
-    int threads = wci_thread_tuner_threads(&w->tuner);
-    memset(&w->stats, 0, sizeof w->stats);
-    w->stats.threads = threads;
-    double *phase = w->phase_seconds, t0 = wci_clock_seconds(), t1;
-    /* soft pins pull toward where their targets are when the integrator
-     * evaluates forces: the step's start, or its end for backward Euler */
-    double goal_fraction = w->def.integrator == WC_INTEGRATOR_IMPLICIT ? pin_fraction : pin_start;
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_cloth *cl = w->cloths[c];
-        wci_forces_compute(cl, w->def.gravity, threads);
-        if (wci_applied_active(cl)) wci_applied_forces_add(cl, goal_fraction, threads);
-        if (cl->wet_forces) wci_wet_forces(cl, threads);
+        wci_forces_compute(cl, w->def.gravity, ctx->threads);
+        if (wci_applied_active(cl)) wci_applied_forces_add(cl, ctx->goal_fraction, ctx->threads);
+        if (cl->wet_forces) wci_wet_forces(cl, ctx->threads);
     }
-    /* wet cloths sticking to each other: after every cloth's own forces */
     wci_cloth_group_adhesion(w->group, w->cloths);
-    t1 = wci_clock_seconds(), phase[0] += t1 - t0, t0 = t1;
+}
+
+/* Positions after the step into nx/ny/nz, then the unstable-step guard. */
+static wc_status integrate_stage(wc_world *w, const step_context *ctx)
+{
     for (int32_t c = 0; c < w->cloth_count; ++c) {
-        wc_status s = integrate_cloth(w, c, dt, pin_fraction, threads);
+        wc_status s = integrate_cloth(w, c, ctx->dt, ctx->pin_fraction, ctx->threads);
         if (s) return s;
     }
-    wc_status s = guard_steps(w, dt, threads);
-    if (s) return s;
-    t1 = wci_clock_seconds(), phase[1] += t1 - t0, t0 = t1;
-    int colliding = w->collider_count > 0 || any_cloth_collision(w);
-    if (colliding) {
-        /* collision changes contacts before it knows it will succeed: a
-         * failed step puts them back (contact_backup.h) */
-        if (wci_contact_backup_save(&w->backup, w->cloths, w->cloth_count) ||
-            wci_cloth_group_save(w->group))
-            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
-                           "out of memory saving the contact state; the world keeps its last "
-                           "good state");
-        s = collide(w, dt, share, steps_left, threads);
-        if (s) {
-            wci_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
-            wci_cloth_group_restore(w->group);
-            return s;
-        }
+    return guard_steps(w, ctx->dt, ctx->threads);
+}
+
+/* Collisions with colliders, between cloths and of each cloth with itself
+ * (wet friction acts in their response). They change contacts before they
+ * know they will succeed: a failed step puts them back (contact_backup.h). */
+static wc_status collide_stage(wc_world *w, const step_context *ctx)
+{
+    if (!ctx->colliding) return WC_OK;
+    if (wci_contact_backup_save(&w->backup, w->cloths, w->cloth_count) ||
+        wci_cloth_group_save(w->group))
+        return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                       "out of memory saving the contact state; the world keeps its last "
+                       "good state");
+    wc_status s = collide(w, ctx);
+    if (s) {
+        wci_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
+        wci_cloth_group_restore(w->group);
     }
-    t1 = wci_clock_seconds(), phase[2] += t1 - t0, t0 = t1;
-    if (colliding)
+    return s;
+}
+
+/* The wet response (stuck particles), then the step's positions become the
+ * current ones for every cloth at once. */
+static void commit_stage(wc_world *w, const step_context *ctx)
+{
+    if (ctx->colliding)
         for (int32_t c = 0; c < w->cloth_count; ++c)
             w->stats.stuck_particles += wci_wet_mark_stuck(w->cloths[c]);
+    wci_particles_commit(&w->particles, w->cloths, w->cloth_count);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
-        wci_cloth_commit(w->cloths[c], dt, colliding);
+        wci_cloth_commit(w->cloths[c], ctx->dt, ctx->colliding);
         w->cloths[c]->guard = w->cloths[c]->guard_next;
     }
     for (int32_t k = 0; k < w->collider_count; ++k) wci_collider_end_step(w->colliders[k]);
+}
+
+/* Wicking and drying. */
+static void wetness_stage(wc_world *w, const step_context *ctx)
+{
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         const wc_material *m = &w->cloths[c]->material;
-        if (m->wicking > 0.0 || m->drying > 0.0) wci_wet_update(w->cloths[c], dt);
+        if (m->wicking > 0.0 || m->drying > 0.0) wci_wet_update(w->cloths[c], ctx->dt);
     }
+}
+
+/* One step of the whole world, as stages. Nothing is committed unless
+ * every cloth's new state is finite, so a failed step leaves the world
+ * exactly as it was. The pins are at pin_start of the way to their targets
+ * when the step starts and at pin_fraction when it ends. */
+static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_left,
+                            double pin_start, double pin_fraction)
+{
+    step_context ctx;
+    ctx.dt = dt, ctx.share = share, ctx.steps_left = steps_left;
+    ctx.pin_start = pin_start, ctx.pin_fraction = pin_fraction;
+    ctx.goal_fraction = w->def.integrator == WC_INTEGRATOR_IMPLICIT ? pin_fraction : pin_start;
+    ctx.threads = wci_thread_tuner_threads(&w->tuner);
+    ctx.colliding = w->collider_count > 0 || any_cloth_collision(w);
+    memset(&w->stats, 0, sizeof w->stats);
+    w->stats.threads = ctx.threads;
+    double *phase = w->phase_seconds, t0 = wci_clock_seconds(), t1;
+
+    forces_stage(w, &ctx);
+    t1 = wci_clock_seconds(), phase[0] += t1 - t0, t0 = t1;
+
+    wc_status s = integrate_stage(w, &ctx);
+    if (s) return s;
+    t1 = wci_clock_seconds(), phase[1] += t1 - t0, t0 = t1;
+
+    s = collide_stage(w, &ctx);
+    if (s) return s;
+    t1 = wci_clock_seconds(), phase[2] += t1 - t0, t0 = t1;
+
+    commit_stage(w, &ctx);
+    wetness_stage(w, &ctx);
     phase[3] += wci_clock_seconds() - t0;
     w->time += dt;
     return WC_OK;

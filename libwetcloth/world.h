@@ -4,6 +4,7 @@
 #include "cloth.h"
 #include "collider.h"
 #include "contact_backup.h"
+#include "particles.h"
 #include "thread_tuner.h"
 #include "wetcloth.h"
 
@@ -12,6 +13,8 @@ struct wc_world {
     wc_cloth **cloths;
     int32_t cloth_count;
     int32_t cloth_capacity;
+    /// The per-particle state of every cloth (particles.h).
+    wc_particles particles;
     wc_collider **colliders;
     int32_t collider_count;
     int32_t collider_capacity;
