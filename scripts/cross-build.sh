@@ -247,4 +247,13 @@ if [ $make_zip = 1 ]; then
     say "Blender extension"
     "$host_python" tools/build_blender_addon.py --platform "$platform" --library "$library" \
         --build-dir "$build" --out dist
+    # Blender's own check of an extension package (its manifest, the wheels
+    # against the platforms), where bpy is installed (scripts/venv-blender.sh).
+    version=$(sed -nE 's/^project\(wetcloth VERSION ([0-9.]+).*/\1/p' CMakeLists.txt)
+    blender_ext=$(ls .venv-blender/lib/python3*/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py 2>/dev/null | head -1 || true)
+    if [ -n "$blender_ext" ]; then
+        .venv-blender/bin/python "$blender_ext" validate "dist/wetcloth-$version-${platform/-/_}.zip"
+    else
+        echo "cross-build: no .venv-blender/ (scripts/venv-blender.sh): the zip is not validated by Blender's extension tool"
+    fi
 fi
