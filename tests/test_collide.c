@@ -449,8 +449,8 @@ static uint64_t thick_drop_hash(int32_t threads)
  * its rest length (a contact fighting the solve stretches links without
  * bound: 6.7x was seen on this scene before the contact stage), and the
  * checker finds no intersection at the end. Dry only: soaked, this scene
- * still stretches links to about 1.6x at the default integrator
- * (docs/model.md, Known gaps). */
+ * still stretches links to about 1.6x at large steps (docs/model.md, Known
+ * gaps). */
 static void thick_sphere_stays_stable(double wetness)
 {
     wc_world_def def = wc_world_def_default();

@@ -34,7 +34,7 @@ w=wc.World(integrator=integ, threads=1)
 v,t=sphere(64,32,0.5)
 w.add_mesh_collider(v,t,thickness=float(kw.get('thick',0.02)),friction=0.5)
 m=wc.Material()
-for k in ('adhesion','spread','wet_friction'):
+for k in ('adhesion','spread','wet_friction','wet_softening','wet_mass_gain'):
     if k in kw: setattr(m,k,float(kw[k]))
 c=w.add_grid_cloth(30,30,size=(2,2),center=(0,0,1),wetness=wet, material=m)
 links=None
