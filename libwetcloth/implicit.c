@@ -34,6 +34,11 @@
 /* Dot products sum fixed blocks of this many particles, then the blocks in
  * order: the same rounding for any thread count. */
 #define BLOCK 512
+/* The sets of partial sums: r . r (and b . b), p . A p, r . z. */
+#define PARTIAL_RR 0
+#define PARTIAL_PQ 1
+#define PARTIAL_RZ 2
+#define PARTIAL_SETS 3
 
 struct wc_implicit_state {
     int32_t n, links, blocks;
@@ -49,6 +54,9 @@ struct wc_implicit_state {
     /// right-hand side, solution, residual, preconditioned residual,
     /// search direction, matrix times direction.
     double *v0, *fixed, *rhs, *y, *r, *z, *p, *q;
+    /// Per block, the sums of the dot products: three sets (PARTIAL_*), so
+    /// that a thread that starts the next sum cannot overwrite one that
+    /// another thread has not yet added up.
     double *partial;
     /// Per link, scratch of the product with the matrix: B (in_a - in_b).
     double *link_product;
@@ -90,7 +98,7 @@ wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
     int ok = 1;
     for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
         ok &= (*vectors[i] = wc_alloc_array(3 * n, sizeof(double))) != NULL;
-    s->partial = wc_alloc_array((size_t)s->blocks, sizeof(double));
+    s->partial = wc_alloc_array(PARTIAL_SETS * (size_t)s->blocks, sizeof(double));
     s->link_product = wc_alloc_array(3 * links + 1, sizeof(double));
     if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
         !s->partial || !s->link_product) {
@@ -149,6 +157,8 @@ typedef struct implicit_pass {
      * particle's aggregate, NULL without coarse levels */
     const double *coarse;
     const int32_t *aggregate;
+    /* where a summing loop puts its per-block sums */
+    double *partial;
 } implicit_pass;
 
 static void set_block(double *b, double along, double across, double ux, double uy, double uz)
@@ -304,10 +314,10 @@ static void block_bounds(const wc_implicit_state *s, int64_t block, int64_t *beg
     *end = *begin + BLOCK < s->n ? *begin + BLOCK : s->n;
 }
 
-static double block_sum(const wc_implicit_state *s)
+static double block_sum(const wc_implicit_state *s, const double *partial)
 {
     double total = 0.0;
-    for (int32_t k = 0; k < s->blocks; ++k) total += s->partial[k];
+    for (int32_t k = 0; k < s->blocks; ++k) total += partial[k];
     return total;
 }
 
@@ -366,7 +376,7 @@ static int apply_range(void *context, int64_t first, int64_t last)
             sum += vi[1] * oy;
             sum += vi[2] * oz;
         }
-        s->partial[block] = sum;
+        pass->partial[block] = sum;
     }
     return 0;
 }
@@ -398,23 +408,26 @@ static int precondition_range(void *context, int64_t first, int64_t last)
             sum += ri[1] * zi[1];
             sum += ri[2] * zi[2];
         }
-        s->partial[block] = sum;
+        pass->partial[block] = sum;
     }
     return 0;
 }
 
-/* a . b over the 3n values. */
-static int dot_range(void *context, int64_t first, int64_t last)
+/* The solve's start, y = 0 and r = b; sums b . b. */
+static int start_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
     wc_implicit_state *s = pass->state;
-    const double *a = pass->a, *b = pass->b;
     for (int64_t block = first; block < last; ++block) {
         int64_t begin, end;
         block_bounds(s, block, &begin, &end);
         double sum = 0.0;
-        for (int64_t i = 3 * begin; i < 3 * end; ++i) sum += a[i] * b[i];
-        s->partial[block] = sum;
+        for (int64_t i = 3 * begin; i < 3 * end; ++i) {
+            s->y[i] = 0.0;
+            s->r[i] = s->rhs[i];
+            sum += s->rhs[i] * s->rhs[i];
+        }
+        pass->partial[block] = sum;
     }
     return 0;
 }
@@ -434,7 +447,7 @@ static int update_solution_range(void *context, int64_t first, int64_t last)
             s->r[i] -= alpha * s->q[i];
             sum += s->r[i] * s->r[i];
         }
-        s->partial[block] = sum;
+        pass->partial[block] = sum;
     }
     return 0;
 }
@@ -453,37 +466,55 @@ static int update_direction_range(void *context, int64_t first, int64_t last)
     return 0;
 }
 
-/* One loop of an iteration over the blocks. */
-static void run_blocks(implicit_pass *pass, wc_range_fn body, int threads)
+/* The first direction, p = z. */
+static int first_direction_range(void *context, int64_t first, int64_t last)
+{
+    const implicit_pass *pass = context;
+    wc_implicit_state *s = pass->state;
+    int64_t begin, end, unused;
+    block_bounds(s, first, &begin, &unused);
+    block_bounds(s, last - 1, &unused, &end);
+    memcpy(s->p + 3 * begin, s->z + 3 * begin, 3 * (size_t)(end - begin) * sizeof(double));
+    return 0;
+}
+
+/* The solve runs in one team (parallel.h): each thread takes the same
+ * slices of the blocks and of the links in every iteration, a barrier
+ * stands wherever a loop reads what other threads wrote, and every thread
+ * adds up the block sums itself in block order: the same scalars, and so
+ * the same decisions, on every thread. The blocks split from
+ * WC_PARALLEL_MIN particles up, as the other per-particle loops do. */
+static void team_blocks(implicit_pass *pass, const wc_team *team, wc_range_fn body, int set)
 {
     wc_implicit_state *s = pass->state;
-    wc_parallel_for(s->blocks, wc_threads_for(s->n, threads), body, pass);
+    int64_t begin, end;
+    wc_team_slice(team, s->blocks, team->threads > 1 && s->n >= WC_PARALLEL_MIN, &begin, &end);
+    pass->partial = s->partial + (size_t)set * (size_t)s->blocks;
+    if (begin < end) body(pass, begin, end);
 }
 
-/* The same for a loop that sums into partial[]: returns the sum. */
-static double summed_blocks(implicit_pass *pass, wc_range_fn body, int threads)
+/* The sum of a set, after the barrier that follows the loop filling it. */
+static double set_sum(const wc_implicit_state *s, int set)
 {
-    run_blocks(pass, body, threads);
-    return block_sum(pass->state);
+    return block_sum(s, s->partial + (size_t)set * (size_t)s->blocks);
 }
 
-static double dot(implicit_pass *pass, const double *a, const double *b, int threads)
-{
-    pass->a = a, pass->b = b;
-    return summed_blocks(pass, dot_range, threads);
-}
-
-/* z = the preconditioner applied to r: block-Jacobi, plus the coarse
- * levels' correction on a large cloth. Returns r . z. */
-static double precondition(implicit_pass *pass, int threads)
+/* z = the preconditioner applied to r (complete on entry): block-Jacobi,
+ * plus the coarse levels' correction on a large cloth; the first time also
+ * p = z. Returns r . z. */
+static double precondition(implicit_pass *pass, const wc_team *team, int first)
 {
     wc_implicit_state *s = pass->state;
     if (s->multigrid) {
-        wc_multigrid_coarse_solve(s->multigrid, s->r, threads);
+        wc_multigrid_coarse_solve_team(s->multigrid, s->r, team);
+        wc_team_barrier(team);
         pass->coarse = wc_multigrid_coarse_solution(s->multigrid);
         pass->aggregate = wc_multigrid_fine_aggregates(s->multigrid);
     }
-    return summed_blocks(pass, precondition_range, threads);
+    team_blocks(pass, team, precondition_range, PARTIAL_RZ);
+    if (first) team_blocks(pass, team, first_direction_range, PARTIAL_RZ);
+    wc_team_barrier(team);
+    return set_sum(s, PARTIAL_RZ);
 }
 
 /* The mass the solve's free particles carry, kg: with the step's
@@ -512,6 +543,57 @@ static double sum_of(const double *values, int count)
     return sum;
 }
 
+typedef struct solve_pass {
+    const implicit_pass *pass;
+    /* velocity_tolerance^2 times the free mass, 0 without a tolerance */
+    double bound;
+} solve_pass;
+
+static void solve_body(void *context, const wc_team *team)
+{
+    const solve_pass *shared = context;
+    implicit_pass pass = *shared->pass; /* each thread's own: loops change its fields */
+    wc_implicit_state *s = pass.state;
+    team_blocks(&pass, team, start_range, PARTIAL_RR);
+    wc_team_barrier(team);
+    double bb = set_sum(s, PARTIAL_RR), rr = bb, bound = shared->bound;
+    int32_t it = 0;
+    if (bb > 0.0) {
+        double rz = precondition(&pass, team, 1);
+        double decrease[ESTIMATE_DELAY] = {0.0};
+        int64_t link_begin, link_end;
+        wc_team_slice(team, s->links, team->threads > 1, &link_begin, &link_end);
+        pass.in = s->p, pass.out = s->q;
+        for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
+            if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
+                break;
+            if (link_begin < link_end) link_products_range(&pass, link_begin, link_end);
+            wc_team_barrier(team);
+            team_blocks(&pass, team, apply_range, PARTIAL_PQ);
+            wc_team_barrier(team);
+            double pq = set_sum(s, PARTIAL_PQ);
+            /* A is positive definite, so pq > 0 unless p = 0 or something
+             * is not finite: then stop, the caller checks the result */
+            if (!(pq > 0.0) || !isfinite(pq)) break;
+            double alpha = rz / pq;
+            decrease[it % ESTIMATE_DELAY] = alpha * rz;
+            pass.factor = alpha;
+            team_blocks(&pass, team, update_solution_range, PARTIAL_RR);
+            wc_team_barrier(team);
+            rr = set_sum(s, PARTIAL_RR);
+            double rz_next = precondition(&pass, team, 0);
+            pass.factor = rz_next / rz;
+            team_blocks(&pass, team, update_direction_range, PARTIAL_RR);
+            wc_team_barrier(team);
+            rz = rz_next;
+        }
+    }
+    if (team->thread == 0) {
+        s->last_iterations = it;
+        s->last_residual = bb > 0.0 ? sqrt(rr / bb) : 0.0;
+    }
+}
+
 /* Preconditioned conjugate gradients on A y = rhs from y = 0, until the
  * residual is 1e-8 of the right-hand side or, when velocity_tolerance > 0,
  * the error's estimated energy norm is at most velocity_tolerance^2 times
@@ -520,43 +602,16 @@ static double sum_of(const double *values, int count)
  * Why not a looser relative residual: on stiff cloth the right-hand side
  * is mostly stiff link forces that the solution cancels, so a residual
  * small against it can still leave a large error in the soft modes (a
- * relative 1e-5 broke the stiff cloth's energy test). */
+ * relative 1e-5 broke the stiff cloth's energy test). The whole solve is
+ * one team (a team of one is a plain call); the links split from
+ * WC_PARALLEL_MIN links up, as before. */
 static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
 {
-    wc_implicit_state *s = pass->state;
-    size_t bytes = 3 * (size_t)s->n * sizeof(double);
-    memset(s->y, 0, bytes);
-    memcpy(s->r, s->rhs, bytes);
-    double bb = dot(pass, s->rhs, s->rhs, threads), rr = bb;
-    int32_t it = 0;
-    if (bb > 0.0) {
-        double rz = precondition(pass, threads);
-        memcpy(s->p, s->z, bytes);
-        double bound = velocity_tolerance > 0.0 ? velocity_tolerance * velocity_tolerance *
-                                                      free_mass(pass)
-                                                : 0.0;
-        double decrease[ESTIMATE_DELAY] = {0.0};
-        for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
-            if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
-                break;
-            pass->in = s->p, pass->out = s->q;
-            wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_products_range, pass);
-            double pq = summed_blocks(pass, apply_range, threads);
-            /* A is positive definite, so pq > 0 unless p = 0 or something
-             * is not finite: then stop, the caller checks the result */
-            if (!(pq > 0.0) || !isfinite(pq)) break;
-            double alpha = rz / pq;
-            decrease[it % ESTIMATE_DELAY] = alpha * rz;
-            pass->factor = alpha;
-            rr = summed_blocks(pass, update_solution_range, threads);
-            double rz_next = precondition(pass, threads);
-            pass->factor = rz_next / rz;
-            run_blocks(pass, update_direction_range, threads);
-            rz = rz_next;
-        }
-    }
-    s->last_iterations = it;
-    s->last_residual = bb > 0.0 ? sqrt(rr / bb) : 0.0;
+    double bound = velocity_tolerance > 0.0
+                       ? velocity_tolerance * velocity_tolerance * free_mass(pass)
+                       : 0.0;
+    solve_pass shared = {pass, bound};
+    wc_parallel_team(wc_threads_for(pass->state->links, threads), solve_body, &shared);
 }
 
 /* First particle whose right-hand side is not finite, -1 if none. Forces
@@ -620,7 +675,7 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doubl
      * backward Euler. */
     double h_prev = c->has_history ? c->dt_prev : 0.0;
     implicit_pass pass = {c, s, dt, pin_fraction, (dt + h_prev) / (2.0 * dt),
-                          NULL, NULL, NULL, NULL, 0.0, NULL, NULL};
+                          NULL, NULL, NULL, NULL, 0.0, NULL, NULL, NULL};
     wc_parallel_for(n, particle_threads, start_velocities_range, &pass);
     wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
     wc_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);

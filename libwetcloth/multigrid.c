@@ -424,25 +424,6 @@ static int sweep_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-static void level_loop(level *l, level *c, wc_range_fn body, const double *in, double *out,
-                       int64_t count, int threads)
-{
-    mg_pass p = {l, c, in, out};
-    wc_parallel_for(count, l->n >= LEVEL_PARALLEL_MIN ? threads : 1, body, &p);
-}
-
-static void residual(level *l, int threads)
-{
-    level_loop(l, NULL, residual_range, NULL, NULL, l->n, threads);
-}
-
-/* One smoothing sweep; the first from x = 0. */
-static void smooth(level *l, int first, int threads)
-{
-    if (!first) residual(l, threads);
-    level_loop(l, NULL, sweep_range, first ? l->b : l->r, NULL, l->n, threads);
-}
-
 /* The coarse right-hand side: each aggregate sums its free members'
  * residuals `in`. */
 static int restrict_range(void *context, int64_t begin, int64_t end)
@@ -476,28 +457,98 @@ static int prolong_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-/* l->x = the V-cycle from coarse level k applied to l->b. */
-static void cycle(wc_multigrid *mg, int32_t k, int threads)
+/* The restriction to a level and that level's first sweep, from x = 0,
+ * in one loop: the sweep at aggregate a reads only the b[a] just summed,
+ * so no thread waits between them. */
+static int restrict_sweep_range(void *context, int64_t begin, int64_t end)
 {
-    level *l = &mg->level[k];
-    smooth(l, 1, threads);
+    const mg_pass *p = context;
+    mg_pass sweep = {p->coarse, NULL, p->coarse->b, NULL};
+    restrict_range(context, begin, end);
+    return sweep_range(&sweep, begin, end);
+}
+
+/* The cycle's loops run inside the caller's team (parallel.h): a level's
+ * loops split across the team from LEVEL_PARALLEL_MIN nodes up, a smaller
+ * level's run on the team's first thread. */
+static int level_split(const wc_team *team, const level *l)
+{
+    return team->threads > 1 && l->n >= LEVEL_PARALLEL_MIN;
+}
+
+static void team_loop(const wc_team *team, int split, wc_range_fn body, level *l, level *c,
+                      const double *in, double *out, int64_t count)
+{
+    mg_pass p = {l, c, in, out};
+    int64_t begin, end;
+    wc_team_slice(team, count, split, &begin, &end);
+    if (begin < end) body(&p, begin, end);
+}
+
+/* Between a loop and the next one that reads what it wrote at other
+ * nodes, or writes what it read there: a barrier, unless both ran on the
+ * first thread alone. */
+static void sync_loops(const wc_team *team, int split_before, int split_after)
+{
+    if (split_before || split_after) wc_team_barrier(team);
+}
+
+/* One smoothing sweep after the first: the residual, then the sweep from
+ * it. The sweep writes x, which the other nodes' residuals read. */
+static void smooth(level *l, int split, const wc_team *team)
+{
+    team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
+    sync_loops(team, split, split);
+    team_loop(team, split, sweep_range, l, NULL, l->r, NULL, l->n);
+}
+
+/* l->x = the V-cycle from coarse level k applied to the restriction of
+ * `in`, the finer level's residual. Its last loop is a sweep of level k,
+ * split as level_split(team, level k); the caller waits for it. */
+static void cycle(wc_multigrid *mg, int32_t k, const double *in, const wc_team *team)
+{
+    level *f = &mg->level[k - 1], *l = &mg->level[k];
+    int split_f = level_split(team, f), split = level_split(team, l);
+    /* the restriction reads the finer level, so it splits by that level's size */
+    team_loop(team, split_f, restrict_sweep_range, f, l, in, l->b, l->n);
+    sync_loops(team, split_f, split);
     if (k + 1 == mg->levels) {
-        for (int s = 1; s < COARSEST_SWEEPS; ++s) smooth(l, 0, threads);
+        for (int s = 1; s < COARSEST_SWEEPS; ++s) {
+            if (s > 1) sync_loops(team, split, split);
+            smooth(l, split, team);
+        }
         return;
     }
     level *c = &mg->level[k + 1];
-    residual(l, threads);
-    level_loop(l, c, restrict_range, l->r, c->b, c->n, threads);
-    cycle(mg, k + 1, threads);
-    level_loop(l, c, prolong_range, NULL, l->x, l->n, threads);
-    smooth(l, 0, threads);
+    team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
+    sync_loops(team, split, split);
+    cycle(mg, k + 1, l->r, team);
+    sync_loops(team, level_split(team, c), split);
+    team_loop(team, split, prolong_range, l, c, NULL, l->x, l->n);
+    sync_loops(team, split, split);
+    smooth(l, split, team);
+}
+
+void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const wc_team *team)
+{
+    cycle(mg, 1, r, team);
+}
+
+typedef struct coarse_solve_pass {
+    wc_multigrid *mg;
+    const double *r;
+} coarse_solve_pass;
+
+static void coarse_solve_body(void *context, const wc_team *team)
+{
+    const coarse_solve_pass *p = context;
+    wc_multigrid_coarse_solve_team(p->mg, p->r, team);
 }
 
 void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads)
 {
-    level *fine = &mg->level[0], *c = &mg->level[1];
-    level_loop(fine, c, restrict_range, r, c->b, c->n, threads);
-    cycle(mg, 1, threads);
+    coarse_solve_pass p = {mg, r};
+    wc_parallel_team(threads, coarse_solve_body, &p);
 }
 
 const double *wc_multigrid_coarse_solution(const wc_multigrid *mg) { return mg->level[1].x; }
@@ -507,7 +558,9 @@ const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg) { return mg-
 void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
 {
     wc_multigrid_coarse_solve(mg, r, threads);
-    level_loop(&mg->level[0], &mg->level[1], prolong_range, NULL, z, mg->level[0].n, threads);
+    mg_pass p = {&mg->level[0], &mg->level[1], NULL, z};
+    wc_parallel_for(mg->level[0].n, mg->level[0].n >= LEVEL_PARALLEL_MIN ? threads : 1,
+                    prolong_range, &p);
 }
 
 int32_t wc_multigrid_level_size(const wc_multigrid *mg, int32_t k) { return mg->level[k].n; }
@@ -524,6 +577,7 @@ void wc_multigrid_level_product(wc_multigrid *mg, int32_t k, const double *in, d
     size_t len = 3 * (size_t)l->n;
     memcpy(l->x, in, len * sizeof *in);
     memset(l->b, 0, len * sizeof *l->b);
-    residual(l, 1);
+    mg_pass p = {l, NULL, NULL, NULL};
+    residual_range(&p, 0, l->n);
     for (size_t k = 0; k < len; ++k) out[k] = -l->r[k];
 }

@@ -36,6 +36,8 @@
 
 #include <stdint.h>
 
+#include "parallel.h"
+
 /// Cloths with fewer particles get no coarse levels: below about this size
 /// the coarse levels cost more per iteration than they save in iterations
 /// (measured on the thesis drape at 12 steps per frame: 7 % slower at 2,500
@@ -77,6 +79,11 @@ void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, i
 /// level, valid until the next call; a free fine node i adds entry
 /// aggregates[i] of it (P), a pinned node nothing.
 void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads);
+/// The same on a team already running (wc_parallel_team), every thread
+/// calling it: r must be complete on entry (a barrier after the loop that
+/// wrote it), and the solution is complete after the caller's next
+/// wc_team_barrier.
+void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const wc_team *team);
 const double *wc_multigrid_coarse_solution(const wc_multigrid *mg);
 const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg);
 
