@@ -21,8 +21,7 @@
 #define SMOOTHING_WEIGHT (2.0 / 3.0)
 #define COARSEST_SWEEPS 4
 /* A level's loops run on the world's threads from this many nodes up (the
- * fine level's count for the restriction, which reads the fine level), far
- * below WC_PARALLEL_MIN: every CG iteration runs a dozen of them per level,
+ * restriction to it too), far below WC_PARALLEL_MIN: every CG iteration runs a dozen of them per level,
  * back to back with the solve's own parallel loops, and left on one thread
  * the first coarse level of a 10,201-particle cloth (1,133 nodes) had the
  * other thread waiting through them. */
@@ -43,8 +42,9 @@ typedef struct level {
      * aggregate's nodes (CSR), each coarse link's fine links (CSR) */
     int32_t *agg, *member_start, *members, *fine_start, *fine_links;
     /* cycle vectors, 3 per node (coarse levels): solution, right-hand
-     * side, residual */
-    double *x, *b, *r;
+     * side, residual, and the solution after the last sweep of a level
+     * above the coarsest (cycle_solution) */
+    double *x, *b, *r, *post;
 } level;
 
 struct wc_multigrid {
@@ -57,7 +57,7 @@ static void level_free(level *l)
     for (int k = 0; k < 4; ++k) wc_free(l->own_ints[k]);
     int32_t *ints[] = {l->agg, l->member_start, l->members, l->fine_start, l->fine_links};
     for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) wc_free(ints[k]);
-    double *doubles[] = {l->diag, l->own_block, l->inv, l->x, l->b, l->r};
+    double *doubles[] = {l->diag, l->own_block, l->inv, l->x, l->b, l->r, l->post};
     for (size_t k = 0; k < sizeof doubles / sizeof doubles[0]; ++k) wc_free(doubles[k]);
 }
 
@@ -243,7 +243,8 @@ static int allocate_values(level *c)
     c->x = wc_alloc_array(3 * n, sizeof(double));
     c->b = wc_alloc_array(3 * n, sizeof(double));
     c->r = wc_alloc_array(3 * n, sizeof(double));
-    return !c->diag || !c->inv || !c->own_block || !c->x || !c->b || !c->r;
+    c->post = wc_alloc_array(3 * n, sizeof(double));
+    return !c->diag || !c->inv || !c->own_block || !c->x || !c->b || !c->r || !c->post;
 }
 
 /* Adds the level above the top one, unless the top one is small enough or
@@ -443,18 +444,69 @@ static int restrict_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-/* out += P x_coarse: each free node takes its aggregate's correction. */
+/* out += P in, in the coarse level's solution: each free node takes its
+ * aggregate's correction. */
 static int prolong_range(void *context, int64_t begin, int64_t end)
 {
     const mg_pass *p = context;
-    const level *f = p->fine, *c = p->coarse;
+    const level *f = p->fine;
     for (int64_t i = begin; i < end; ++i) {
         if (pinned(f, (int32_t)i)) continue;
-        const double *xc = c->x + 3 * (size_t)f->agg[i];
+        const double *xc = p->in + 3 * (size_t)f->agg[i];
         double *x = p->out + 3 * (size_t)i;
         x[0] += xc[0], x[1] += xc[1], x[2] += xc[2];
     }
     return 0;
+}
+
+/* Node i's x after the coarse correction, x_i + (P in)_i, as prolong_range
+ * adds it. */
+static void corrected(const level *l, const double *in, int32_t i, double *out)
+{
+    const double *x = l->x + 3 * (size_t)i;
+    out[0] = x[0], out[1] = x[1], out[2] = x[2];
+    if (pinned(l, i)) return;
+    const double *xc = in + 3 * (size_t)l->agg[i];
+    out[0] += xc[0], out[1] += xc[1], out[2] += xc[2];
+}
+
+/* The coarse correction and the sweep after it in one loop, the
+ * correction taken at each node where it is read: post = x' + w D_full^-1
+ * (b - A x'), x' = x + P in. The same arithmetic as prolong_range,
+ * residual_range and sweep_range one after the other, without the two
+ * barriers between them: x' is never stored, and the sweep writes post,
+ * not the x that other nodes' rows read. */
+static int correct_smooth_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    level *l = p->fine;
+    for (int64_t i = begin; i < end; ++i) {
+        double xi[3], xj[3], t[3], ax[3], r[3];
+        corrected(l, p->in, (int32_t)i, xi);
+        wc_sym3_times(l->diag + 6 * (size_t)i, xi[0], xi[1], xi[2], ax);
+        for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k) {
+            corrected(l, p->in, other_end(l, l->adj[k]), xj);
+            wc_sym3_times(l->block + 6 * (size_t)link_of(l->adj[k]), xi[0] - xj[0], xi[1] - xj[1],
+                          xi[2] - xj[2], t);
+            ax[0] += t[0], ax[1] += t[1], ax[2] += t[2];
+        }
+        const double *b = l->b + 3 * (size_t)i;
+        r[0] = b[0] - ax[0], r[1] = b[1] - ax[1], r[2] = b[2] - ax[2];
+        wc_sym3_times(l->inv + 6 * (size_t)i, r[0], r[1], r[2], t);
+        double *x = p->out + 3 * (size_t)i;
+        x[0] = xi[0], x[1] = xi[1], x[2] = xi[2];
+        x[0] += SMOOTHING_WEIGHT * t[0];
+        x[1] += SMOOTHING_WEIGHT * t[1];
+        x[2] += SMOOTHING_WEIGHT * t[2];
+    }
+    return 0;
+}
+
+/* Where level k's cycle leaves its solution: the coarsest level's sweeps
+ * update x in place, a level above it ends in post (correct_smooth_range). */
+static double *cycle_solution(const wc_multigrid *mg, int32_t k)
+{
+    return k + 1 == mg->levels ? mg->level[k].x : mg->level[k].post;
 }
 
 /* The restriction to a level and that level's first sweep, from x = 0,
@@ -502,16 +554,17 @@ static void smooth(level *l, int split, const wc_team *team)
     team_loop(team, split, sweep_range, l, NULL, l->r, NULL, l->n);
 }
 
-/* l->x = the V-cycle from coarse level k applied to the restriction of
- * `in`, the finer level's residual. Its last loop is a sweep of level k,
- * split as level_split(team, level k); the caller waits for it. */
+/* cycle_solution(k) = the V-cycle from coarse level k applied to the
+ * restriction of `in`, the finer level's residual (complete on entry).
+ * Every loop of level k splits as level_split(team, level k), the
+ * restriction to it too: a small level's whole cycle then runs on the
+ * first thread without a barrier. The caller waits for the last loop. */
 static void cycle(wc_multigrid *mg, int32_t k, const double *in, const wc_team *team)
 {
     level *f = &mg->level[k - 1], *l = &mg->level[k];
-    int split_f = level_split(team, f), split = level_split(team, l);
-    /* the restriction reads the finer level, so it splits by that level's size */
-    team_loop(team, split_f, restrict_sweep_range, f, l, in, l->b, l->n);
-    sync_loops(team, split_f, split);
+    int split = level_split(team, l);
+    team_loop(team, split, restrict_sweep_range, f, l, in, l->b, l->n);
+    sync_loops(team, split, split);
     if (k + 1 == mg->levels) {
         for (int s = 1; s < COARSEST_SWEEPS; ++s) {
             if (s > 1) sync_loops(team, split, split);
@@ -520,13 +573,12 @@ static void cycle(wc_multigrid *mg, int32_t k, const double *in, const wc_team *
         return;
     }
     level *c = &mg->level[k + 1];
+    int split_c = level_split(team, c);
     team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
-    sync_loops(team, split, split);
+    sync_loops(team, split, split_c);
     cycle(mg, k + 1, l->r, team);
-    sync_loops(team, level_split(team, c), split);
-    team_loop(team, split, prolong_range, l, c, NULL, l->x, l->n);
-    sync_loops(team, split, split);
-    smooth(l, split, team);
+    sync_loops(team, split_c, split);
+    team_loop(team, split, correct_smooth_range, l, c, cycle_solution(mg, k + 1), l->post, l->n);
 }
 
 void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const wc_team *team)
@@ -551,14 +603,17 @@ void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads)
     wc_parallel_team(threads, coarse_solve_body, &p);
 }
 
-const double *wc_multigrid_coarse_solution(const wc_multigrid *mg) { return mg->level[1].x; }
+const double *wc_multigrid_coarse_solution(const wc_multigrid *mg)
+{
+    return cycle_solution(mg, 1);
+}
 
 const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg) { return mg->level[0].agg; }
 
 void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
 {
     wc_multigrid_coarse_solve(mg, r, threads);
-    mg_pass p = {&mg->level[0], &mg->level[1], NULL, z};
+    mg_pass p = {&mg->level[0], &mg->level[1], cycle_solution(mg, 1), z};
     wc_parallel_for(mg->level[0].n, mg->level[0].n >= LEVEL_PARALLEL_MIN ? threads : 1,
                     prolong_range, &p);
 }
