@@ -51,9 +51,10 @@ struct wc_implicit_state {
     /// and the inverse of the whole 3 x 3 diagonal block (6 values).
     double *mass_diag, *precond;
     /// 3n vectors, xyz interleaved: start velocity, known dv of pins,
-    /// right-hand side, solution, residual, preconditioned residual,
-    /// search direction, matrix times direction.
-    double *v0, *fixed, *rhs, *y, *r, *z, *p, *q;
+    /// right-hand side, solution, residual (two: an iteration writes the
+    /// new one while the coarse levels read the old one), preconditioned
+    /// residual, search direction, matrix times direction.
+    double *v0, *fixed, *rhs, *y, *r, *r_next, *z, *p, *q;
     /// Per block, the sums of the dot products: three sets (PARTIAL_*), so
     /// that a thread that starts the next sum cannot overwrite one that
     /// another thread has not yet added up.
@@ -71,7 +72,8 @@ void wc_implicit_state_destroy(wc_implicit_state *s)
 {
     if (!s) return;
     double *arrays[] = {s->block, s->kv, s->mass_diag, s->precond, s->v0, s->fixed, s->rhs,
-                        s->y, s->r, s->z, s->p, s->q, s->partial, s->link_product};
+                        s->y, s->r, s->r_next, s->z, s->p, s->q, s->partial,
+                        s->link_product};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
     wc_free(s->end_a);
     wc_free(s->end_b);
@@ -94,7 +96,7 @@ wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
     s->kv = wc_alloc_array(3 * links, sizeof(double));
     s->mass_diag = wc_alloc_array(n, sizeof(double));
     s->precond = wc_alloc_array(6 * n, sizeof(double));
-    double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r, &s->z, &s->p, &s->q};
+    double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r, &s->r_next, &s->z, &s->p, &s->q};
     int ok = 1;
     for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
         ok &= (*vectors[i] = wc_alloc_array(3 * n, sizeof(double))) != NULL;
@@ -159,6 +161,8 @@ typedef struct implicit_pass {
     const int32_t *aggregate;
     /* where a summing loop puts its per-block sums */
     double *partial;
+    /* the solve's residual and where its update goes (they swap) */
+    double *r, *r_next;
 } implicit_pass;
 
 static void set_block(double *b, double along, double across, double ux, double uy, double uz)
@@ -389,7 +393,7 @@ static int precondition_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
     wc_implicit_state *s = pass->state;
-    const double *r = s->r, *precond = s->precond, *coarse = pass->coarse;
+    const double *r = pass->r, *precond = s->precond, *coarse = pass->coarse;
     const int32_t *aggregate = pass->aggregate, *pin_slot = pass->cloth->pin_slot;
     double *z = s->z;
     for (int64_t block = first; block < last; ++block) {
@@ -424,7 +428,7 @@ static int start_range(void *context, int64_t first, int64_t last)
         double sum = 0.0;
         for (int64_t i = 3 * begin; i < 3 * end; ++i) {
             s->y[i] = 0.0;
-            s->r[i] = s->rhs[i];
+            pass->r[i] = s->rhs[i];
             sum += s->rhs[i] * s->rhs[i];
         }
         pass->partial[block] = sum;
@@ -432,7 +436,7 @@ static int start_range(void *context, int64_t first, int64_t last)
     return 0;
 }
 
-/* y += alpha p; r -= alpha q; sums r . r. */
+/* y += alpha p; r_next = r - alpha q; sums r_next . r_next. */
 static int update_solution_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
@@ -444,8 +448,8 @@ static int update_solution_range(void *context, int64_t first, int64_t last)
         double sum = 0.0;
         for (int64_t i = 3 * begin; i < 3 * end; ++i) {
             s->y[i] += alpha * s->p[i];
-            s->r[i] -= alpha * s->q[i];
-            sum += s->r[i] * s->r[i];
+            pass->r_next[i] = pass->r[i] - alpha * s->q[i];
+            sum += pass->r_next[i] * pass->r_next[i];
         }
         pass->partial[block] = sum;
     }
@@ -499,14 +503,18 @@ static double set_sum(const wc_implicit_state *s, int set)
     return block_sum(s, s->partial + (size_t)set * (size_t)s->blocks);
 }
 
-/* z = the preconditioner applied to r (complete on entry): block-Jacobi,
- * plus the coarse levels' correction on a large cloth; the first time also
- * p = z. Returns r . z. */
-static double precondition(implicit_pass *pass, const wc_team *team, int first)
+/* z = the preconditioner applied to r: block-Jacobi, plus the coarse
+ * levels' correction on a large cloth; the first time also p = z. Returns
+ * r . z. The coarse levels read r as r_old - alpha q (r_old: the residual
+ * before this iteration's update, complete, as q is; q NULL on the first
+ * call, r_old then r itself), so they run in the same phase as the update
+ * of r, whose rows block-Jacobi reads on the thread that wrote them. */
+static double precondition(implicit_pass *pass, const wc_team *team, int first,
+                           const double *r_old, const double *q, double alpha)
 {
     wc_implicit_state *s = pass->state;
     if (s->multigrid) {
-        wc_multigrid_coarse_solve_team(s->multigrid, s->r, team);
+        wc_multigrid_coarse_solve_team(s->multigrid, r_old, q, alpha, team);
         wc_team_barrier(team);
         pass->coarse = wc_multigrid_coarse_solution(s->multigrid);
         pass->aggregate = wc_multigrid_fine_aggregates(s->multigrid);
@@ -554,12 +562,13 @@ static void solve_body(void *context, const wc_team *team)
     const solve_pass *shared = context;
     implicit_pass pass = *shared->pass; /* each thread's own: loops change its fields */
     wc_implicit_state *s = pass.state;
+    pass.r = s->r, pass.r_next = s->r_next;
     team_blocks(&pass, team, start_range, PARTIAL_RR);
     wc_team_barrier(team);
     double bb = set_sum(s, PARTIAL_RR), rr = bb, bound = shared->bound;
     int32_t it = 0;
     if (bb > 0.0) {
-        double rz = precondition(&pass, team, 1);
+        double rz = precondition(&pass, team, 1, pass.r, NULL, 0.0);
         double decrease[ESTIMATE_DELAY] = {0.0};
         int64_t link_begin, link_end;
         wc_team_slice(team, s->links, team->threads > 1, &link_begin, &link_end);
@@ -579,9 +588,10 @@ static void solve_body(void *context, const wc_team *team)
             decrease[it % ESTIMATE_DELAY] = alpha * rz;
             pass.factor = alpha;
             team_blocks(&pass, team, update_solution_range, PARTIAL_RR);
-            wc_team_barrier(team);
+            double *r_old = pass.r;
+            pass.r = pass.r_next, pass.r_next = r_old;
+            double rz_next = precondition(&pass, team, 0, r_old, s->q, alpha);
             rr = set_sum(s, PARTIAL_RR);
-            double rz_next = precondition(&pass, team, 0);
             pass.factor = rz_next / rz;
             team_blocks(&pass, team, update_direction_range, PARTIAL_RR);
             wc_team_barrier(team);
@@ -675,7 +685,7 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doubl
      * backward Euler. */
     double h_prev = c->has_history ? c->dt_prev : 0.0;
     implicit_pass pass = {c, s, dt, pin_fraction, (dt + h_prev) / (2.0 * dt),
-                          NULL, NULL, NULL, NULL, 0.0, NULL, NULL, NULL};
+                          NULL, NULL, NULL, NULL, 0.0, NULL, NULL, NULL, NULL, NULL};
     wc_parallel_for(n, particle_threads, start_velocities_range, &pass);
     wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
     wc_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);

@@ -300,11 +300,14 @@ int wc_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const in
 /* ------------------------------------------------------------------------ */
 
 /* One loop over a level's nodes or links: its level, the coarser one, and
- * the vectors it reads and writes. */
+ * the vectors it reads and writes. A restriction with `minus` reads in -
+ * factor minus instead of in. */
 typedef struct mg_pass {
     level *fine, *coarse;
     const double *in;
     double *out;
+    const double *minus;
+    double factor;
 } mg_pass;
 
 static int pinned(const level *l, int32_t i) { return l->pin_slot && l->pin_slot[i] >= 0; }
@@ -373,7 +376,7 @@ void wc_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double
     level *fine = &mg->level[0];
     fine->mass = mass_diag, fine->block = block, fine->pin_slot = pin_slot;
     for (int32_t k = 0; k + 1 < mg->levels; ++k) {
-        mg_pass p = {&mg->level[k], &mg->level[k + 1], NULL, NULL};
+        mg_pass p = {&mg->level[k], &mg->level[k + 1], NULL, NULL, NULL, 0.0};
         int32_t links = p.coarse->links, nodes = p.coarse->n;
         wc_parallel_for(links, wc_threads_for(links, threads), coarse_links_range, &p);
         wc_parallel_for(nodes, wc_threads_for(nodes, threads), coarse_nodes_range, &p);
@@ -437,7 +440,13 @@ static int restrict_range(void *context, int64_t begin, int64_t end)
             int32_t i = f->members[m];
             if (pinned(f, i)) continue;
             const double *r = p->in + 3 * (size_t)i;
-            s[0] += r[0], s[1] += r[1], s[2] += r[2];
+            if (p->minus) {
+                const double *m = p->minus + 3 * (size_t)i;
+                double f = p->factor, v[3] = {r[0] - f * m[0], r[1] - f * m[1], r[2] - f * m[2]};
+                s[0] += v[0], s[1] += v[1], s[2] += v[2];
+            } else {
+                s[0] += r[0], s[1] += r[1], s[2] += r[2];
+            }
         }
         memcpy(p->out + 3 * (size_t)a, s, sizeof s);
     }
@@ -515,7 +524,7 @@ static double *cycle_solution(const wc_multigrid *mg, int32_t k)
 static int restrict_sweep_range(void *context, int64_t begin, int64_t end)
 {
     const mg_pass *p = context;
-    mg_pass sweep = {p->coarse, NULL, p->coarse->b, NULL};
+    mg_pass sweep = {p->coarse, NULL, p->coarse->b, NULL, NULL, 0.0};
     restrict_range(context, begin, end);
     return sweep_range(&sweep, begin, end);
 }
@@ -531,7 +540,7 @@ static int level_split(const wc_team *team, const level *l)
 static void team_loop(const wc_team *team, int split, wc_range_fn body, level *l, level *c,
                       const double *in, double *out, int64_t count)
 {
-    mg_pass p = {l, c, in, out};
+    mg_pass p = {l, c, in, out, NULL, 0.0};
     int64_t begin, end;
     wc_team_slice(team, count, split, &begin, &end);
     if (begin < end) body(&p, begin, end);
@@ -555,15 +564,20 @@ static void smooth(level *l, int split, const wc_team *team)
 }
 
 /* cycle_solution(k) = the V-cycle from coarse level k applied to the
- * restriction of `in`, the finer level's residual (complete on entry).
+ * restriction of `in` (minus `factor` times `minus`, when not NULL), the
+ * finer level's residual (complete on entry).
  * Every loop of level k splits as level_split(team, level k), the
  * restriction to it too: a small level's whole cycle then runs on the
  * first thread without a barrier. The caller waits for the last loop. */
-static void cycle(wc_multigrid *mg, int32_t k, const double *in, const wc_team *team)
+static void cycle(wc_multigrid *mg, int32_t k, const double *in, const double *minus,
+                  double factor, const wc_team *team)
 {
     level *f = &mg->level[k - 1], *l = &mg->level[k];
     int split = level_split(team, l);
-    team_loop(team, split, restrict_sweep_range, f, l, in, l->b, l->n);
+    mg_pass restriction = {f, l, in, l->b, minus, factor};
+    int64_t begin, end;
+    wc_team_slice(team, l->n, split, &begin, &end);
+    if (begin < end) restrict_sweep_range(&restriction, begin, end);
     sync_loops(team, split, split);
     if (k + 1 == mg->levels) {
         for (int s = 1; s < COARSEST_SWEEPS; ++s) {
@@ -576,14 +590,15 @@ static void cycle(wc_multigrid *mg, int32_t k, const double *in, const wc_team *
     int split_c = level_split(team, c);
     team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
     sync_loops(team, split, split_c);
-    cycle(mg, k + 1, l->r, team);
+    cycle(mg, k + 1, l->r, NULL, 0.0, team);
     sync_loops(team, split_c, split);
     team_loop(team, split, correct_smooth_range, l, c, cycle_solution(mg, k + 1), l->post, l->n);
 }
 
-void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const wc_team *team)
+void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
+                                    double alpha, const wc_team *team)
 {
-    cycle(mg, 1, r, team);
+    cycle(mg, 1, r, q, alpha, team);
 }
 
 typedef struct coarse_solve_pass {
@@ -594,7 +609,7 @@ typedef struct coarse_solve_pass {
 static void coarse_solve_body(void *context, const wc_team *team)
 {
     const coarse_solve_pass *p = context;
-    wc_multigrid_coarse_solve_team(p->mg, p->r, team);
+    wc_multigrid_coarse_solve_team(p->mg, p->r, NULL, 0.0, team);
 }
 
 void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads)
@@ -613,7 +628,7 @@ const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg) { return mg-
 void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
 {
     wc_multigrid_coarse_solve(mg, r, threads);
-    mg_pass p = {&mg->level[0], &mg->level[1], cycle_solution(mg, 1), z};
+    mg_pass p = {&mg->level[0], &mg->level[1], cycle_solution(mg, 1), z, NULL, 0.0};
     wc_parallel_for(mg->level[0].n, mg->level[0].n >= LEVEL_PARALLEL_MIN ? threads : 1,
                     prolong_range, &p);
 }
@@ -632,7 +647,7 @@ void wc_multigrid_level_product(wc_multigrid *mg, int32_t k, const double *in, d
     size_t len = 3 * (size_t)l->n;
     memcpy(l->x, in, len * sizeof *in);
     memset(l->b, 0, len * sizeof *l->b);
-    mg_pass p = {l, NULL, NULL, NULL};
+    mg_pass p = {l, NULL, NULL, NULL, NULL, 0.0};
     residual_range(&p, 0, l->n);
     for (size_t k = 0; k < len; ++k) out[k] = -l->r[k];
 }

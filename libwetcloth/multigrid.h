@@ -80,10 +80,13 @@ void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, i
 /// aggregates[i] of it (P), a pinned node nothing.
 void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads);
 /// The same on a team already running (wc_parallel_team), every thread
-/// calling it: r must be complete on entry (a barrier after the loop that
-/// wrote it), and the solution is complete after the caller's next
-/// wc_team_barrier.
-void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const wc_team *team);
+/// calling it, for the residual r - alpha q (q NULL: r), computed where it
+/// is read as (r - alpha * q) is: r and q must be complete on entry (a
+/// barrier after the loops that wrote them), and the solution is complete
+/// after the caller's next wc_team_barrier. So a caller can update r out
+/// of place in the same phase.
+void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
+                                    double alpha, const wc_team *team);
 const double *wc_multigrid_coarse_solution(const wc_multigrid *mg);
 const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg);
 
