@@ -96,7 +96,8 @@ wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
     s->kv = wc_alloc_array(3 * links, sizeof(double));
     s->mass_diag = wc_alloc_array(n, sizeof(double));
     s->precond = wc_alloc_array(6 * n, sizeof(double));
-    double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r, &s->r_next, &s->z, &s->p, &s->q};
+    double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r,
+                          &s->r_next, &s->z, &s->p, &s->q};
     int ok = 1;
     for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
         ok &= (*vectors[i] = wc_alloc_array(3 * n, sizeof(double))) != NULL;
@@ -151,8 +152,8 @@ typedef struct implicit_pass {
     /* the part of the velocity change that the positions take: x+ = x + h
      * (v0 + share dv), share = (h + h_prev) / 2h (see wc_integrate_implicit) */
     double share;
-    /* dot: a . b; apply: out = A in; updates: the factor */
-    const double *a, *b, *in;
+    /* apply: out = A in; updates: the factor */
+    const double *in;
     double *out;
     double factor;
     /* precondition: the coarse levels' solution per aggregate and each
@@ -685,7 +686,7 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doubl
      * backward Euler. */
     double h_prev = c->has_history ? c->dt_prev : 0.0;
     implicit_pass pass = {c, s, dt, pin_fraction, (dt + h_prev) / (2.0 * dt),
-                          NULL, NULL, NULL, NULL, 0.0, NULL, NULL, NULL, NULL, NULL};
+                          NULL, NULL, 0.0, NULL, NULL, NULL, NULL, NULL};
     wc_parallel_for(n, particle_threads, start_velocities_range, &pass);
     wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
     wc_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);

@@ -20,11 +20,11 @@
  * Laplacian-like matrix best. */
 #define SMOOTHING_WEIGHT (2.0 / 3.0)
 #define COARSEST_SWEEPS 4
-/* A level's loops run on the world's threads from this many nodes up (the
- * restriction to it too), far below WC_PARALLEL_MIN: every CG iteration runs a dozen of them per level,
- * back to back with the solve's own parallel loops, and left on one thread
- * the first coarse level of a 10,201-particle cloth (1,133 nodes) had the
- * other thread waiting through them. */
+/* A level's loops (the restriction to it too) split across the solve's
+ * threads from this many nodes up, far below WC_PARALLEL_MIN: every CG
+ * iteration runs them back to back with the solve's own loops, and left on
+ * one thread the first coarse level of a 10,201-particle cloth (1,133
+ * nodes) had the other thread waiting through them. */
 #define LEVEL_PARALLEL_MIN 256
 
 typedef struct level {
