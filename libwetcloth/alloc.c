@@ -24,7 +24,7 @@ void wc_set_allocator(wc_alloc_fcn *alloc_fcn, wc_free_fcn *free_fcn, void *user
     }
 }
 
-void *wc_alloc_array(size_t count, size_t size)
+void *wci_alloc_array(size_t count, size_t size)
 {
     /* asking for at least one byte keeps a zero-length array distinct from a
      * failure */
@@ -38,7 +38,7 @@ void *wc_alloc_array(size_t count, size_t size)
     return memory;
 }
 
-void wc_free(void *memory)
+void wci_free(void *memory)
 {
     if (!memory) return;
     if (g_free)

@@ -7,9 +7,9 @@
 #include <stddef.h>
 
 /// Zeroed array of count elements of size bytes; NULL on failure or overflow.
-void *wc_alloc_array(size_t count, size_t size);
+void *wci_alloc_array(size_t count, size_t size);
 
-/// Frees what wc_alloc_array returned. NULL is allowed (and never reaches a hook).
-void wc_free(void *memory);
+/// Frees what wci_alloc_array returned. NULL is allowed (and never reaches a hook).
+void wci_free(void *memory);
 
 #endif

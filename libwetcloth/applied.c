@@ -15,7 +15,7 @@
 #define MAX_AIR_SPEED 1e4
 #define MAX_FORCE_DENSITY 1e6
 
-int wc_applied_active(const wc_cloth *c)
+int wci_applied_active(const wc_cloth *c)
 {
     return (c->air_velocity && c->material.air_drag > 0.0) || c->external_force ||
            c->pins.soft_count > 0;
@@ -47,7 +47,7 @@ static int applied_range(void *context, int64_t begin, int64_t end)
         if (p->soft_pin_slot && p->soft_pin_slot[i] >= 0) {
             int32_t slot = p->soft_pin_slot[i];
             double target[3];
-            wc_pinned_position(c, slot, p->target_fraction, target);
+            wci_pinned_position(c, slot, p->target_fraction, target);
             /* k = m s: the particle's own angular frequency about its
              * target is sqrt(s) whatever its mass, so the same stiffness
              * gives the same motion at any mesh resolution and wetness */
@@ -61,13 +61,13 @@ static int applied_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-void wc_applied_forces_add(wc_cloth *c, double target_fraction, int threads)
+void wci_applied_forces_add(wc_cloth *c, double target_fraction, int threads)
 {
     applied_pass pass = {c, target_fraction,
                          c->material.air_drag > 0.0 ? c->air_velocity : NULL,
                          c->external_force, c->pins.soft_count > 0 ? c->soft_pin_slot : NULL};
     int32_t n = c->particle_count;
-    wc_parallel_for(n, wc_threads_for(n, threads), applied_range, &pass);
+    wci_parallel_for(n, wc_threads_for(n, threads), applied_range, &pass);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -98,12 +98,12 @@ static wc_status check_field(const wc_world *w, const field_kind *kind, const do
         const double *v = xyz + 3 * (size_t)i;
         for (int k = 0; k < 3; ++k)
             if (!isfinite(v[k]))
-                return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+                return wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT,
                                "%s: %s[%ld] (%c of particle %d) must be finite but is %g",
                                kind->caller, kind->argument, 3L * i + k, "xyz"[k], (int)i, v[k]);
         double length = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         if (!(length <= kind->limit))
-            return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT,
                            "%s: the %s of particle %d is (%g, %g, %g), of length %g %s; it must "
                            "be at most %g %s",
                            kind->caller, kind->quantity, (int)i, v[0], v[1], v[2], length,
@@ -118,28 +118,28 @@ static wc_status set_field(wc_world *w, int32_t cloth, const double *xyz, int32_
                            const field_kind *kind)
 {
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
-    wc_cloth *c = wc_world_find_cloth(w, cloth, kind->caller);
+    wc_cloth *c = wci_world_find_cloth(w, cloth, kind->caller);
     if (!c) return WC_ERROR_NOT_FOUND;
     double **field = kind->id == FIELD_AIR_VELOCITY ? &c->air_velocity : &c->external_force;
     if (!xyz) {
         if (count != 0)
-            return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                            "%s: %s is NULL but count is %d (NULL with count 0 clears the %s)",
                            kind->caller, kind->argument, (int)count, kind->quantity);
-        wc_free(*field);
+        wci_free(*field);
         *field = NULL;
         return WC_OK;
     }
     if (count != c->particle_count)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "%s: count must be %d for cloth %d (its particle count) but is %d",
                        kind->caller, (int)c->particle_count, (int)cloth, (int)count);
     wc_status s = check_field(w, kind, xyz, count);
     if (s) return s;
     if (!*field) {
-        *field = wc_alloc_array(3 * (size_t)count, sizeof **field);
+        *field = wci_alloc_array(3 * (size_t)count, sizeof **field);
         if (!*field)
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "%s: out of memory for the %s of %d particles", kind->caller,
                            kind->quantity, (int)count);
     }

@@ -9,13 +9,12 @@
 /* Deeper than a median-split tree over 2^27 items can get (27 levels). */
 #define STACK_DEPTH 96
 
-void wc_bvh_init(wc_bvh *b) { memset(b, 0, sizeof *b); }
 
-void wc_bvh_free(wc_bvh *b)
+void wci_bvh_destroy(wc_bvh *b)
 {
-    wc_free(b->nodes);
-    wc_free(b->order);
-    wc_bvh_init(b);
+    wci_free(b->nodes);
+    wci_free(b->order);
+    memset(b, 0, sizeof *b);
 }
 
 static void empty_box(double box[6])
@@ -88,15 +87,15 @@ static int split_axis(const double *boxes, const int32_t *items, int32_t n, doub
     return axis;
 }
 
-wc_status wc_bvh_build(wc_bvh *b, const double *boxes, int32_t count)
+wc_status wci_bvh_create(wc_bvh *b, const double *boxes, int32_t count)
 {
-    wc_bvh_free(b);
+    wci_bvh_destroy(b);
     b->boxes = boxes;
     if (count <= 0) return WC_OK;
-    b->order = wc_alloc_array((size_t)count, sizeof *b->order);
-    b->nodes = wc_alloc_array(2 * (size_t)count, sizeof *b->nodes);
+    b->order = wci_alloc_array((size_t)count, sizeof *b->order);
+    b->nodes = wci_alloc_array(2 * (size_t)count, sizeof *b->nodes);
     if (!b->order || !b->nodes) {
-        wc_bvh_free(b);
+        wci_bvh_destroy(b);
         return WC_ERROR_OUT_OF_MEMORY;
     }
     b->item_count = count;
@@ -127,7 +126,7 @@ wc_status wc_bvh_build(wc_bvh *b, const double *boxes, int32_t count)
     return WC_OK;
 }
 
-void wc_bvh_refit(wc_bvh *b)
+void wci_bvh_refit(wc_bvh *b)
 {
     for (int32_t k = b->node_count - 1; k >= 0; --k) {
         wc_bvh_node *node = b->nodes + k;
@@ -167,7 +166,7 @@ static void sort_items(int32_t *items, int32_t n)
     }
 }
 
-int32_t wc_bvh_collect(const wc_bvh *b, const double box[6], int32_t *out, int32_t capacity)
+int32_t wci_bvh_collect(const wc_bvh *b, const double box[6], int32_t *out, int32_t capacity)
 {
     if (b->node_count == 0) return 0;
     int32_t stack[STACK_DEPTH], depth = 0, found = 0;
@@ -190,15 +189,15 @@ int32_t wc_bvh_collect(const wc_bvh *b, const double box[6], int32_t *out, int32
     return found;
 }
 
-int32_t wc_bvh_query(const wc_bvh *b, const double box[6], int32_t *out, int32_t capacity)
+int32_t wci_bvh_query(const wc_bvh *b, const double box[6], int32_t *out, int32_t capacity)
 {
-    int32_t found = wc_bvh_collect(b, box, out, capacity);
+    int32_t found = wci_bvh_collect(b, box, out, capacity);
     /* only a complete answer is sorted; the caller asks again with room */
     if (found <= capacity) sort_items(out, found);
     return found;
 }
 
-double wc_bvh_root_distance(const wc_bvh *b, const double p[3])
+double wci_bvh_root_distance(const wc_bvh *b, const double p[3])
 {
     if (b->node_count == 0) return INFINITY;
     const double *box = b->nodes[0].box;

@@ -45,26 +45,25 @@ typedef struct wc_bvh {
     const double *boxes;
 } wc_bvh;
 
-void wc_bvh_init(wc_bvh *bvh);
-void wc_bvh_free(wc_bvh *bvh);
+void wci_bvh_destroy(wc_bvh *bvh);
 
 /// Builds the tree over `count` boxes. Non-finite boxes are allowed (they
 /// meet no query). WC_ERROR_OUT_OF_MEMORY on failure (the tree is then empty).
-wc_status wc_bvh_build(wc_bvh *bvh, const double *boxes, int32_t count);
+wc_status wci_bvh_create(wc_bvh *bvh, const double *boxes, int32_t count);
 
 /// After the boxes changed in place: every node's box made from them again.
-void wc_bvh_refit(wc_bvh *bvh);
+void wci_bvh_refit(wc_bvh *bvh);
 
 /// Items whose boxes overlap `box` (touching counts), ascending, into out (up
 /// to capacity); returns how many there are (which may exceed capacity).
-int32_t wc_bvh_query(const wc_bvh *bvh, const double box[6], int32_t *out, int32_t capacity);
+int32_t wci_bvh_query(const wc_bvh *bvh, const double box[6], int32_t *out, int32_t capacity);
 
 /// The same, in the tree's order (not sorted): for callers that sort what
 /// they keep of it themselves.
-int32_t wc_bvh_collect(const wc_bvh *bvh, const double box[6], int32_t *out, int32_t capacity);
+int32_t wci_bvh_collect(const wc_bvh *bvh, const double box[6], int32_t *out, int32_t capacity);
 
 /// Distance from point p to the tree's root box (0 inside it; +inf for an
 /// empty tree): no item is nearer.
-double wc_bvh_root_distance(const wc_bvh *bvh, const double p[3]);
+double wci_bvh_root_distance(const wc_bvh *bvh, const double p[3]);
 
 #endif

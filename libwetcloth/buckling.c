@@ -56,7 +56,7 @@ static double initial_guess(double gap)
     return p * sqrt(gap);
 }
 
-double wc_inverse_sinc_gap(double gap)
+double wci_inverse_sinc_gap(double gap)
 {
     if (!(gap > 0.0)) return 0.0; /* also maps NaN to 0: never propagate it */
     if (gap >= 1.0) return WC_PI;
@@ -87,26 +87,26 @@ double wc_inverse_sinc_gap(double gap)
     return theta;
 }
 
-double wc_inverse_sinc(double r)
+double wci_inverse_sinc(double r)
 {
-    return wc_inverse_sinc_gap(1.0 - r);
+    return wci_inverse_sinc_gap(1.0 - r);
 }
 
-double wc_buckling_phi(double theta)
+double wci_buckling_phi(double theta)
 {
     double gap_of, q;
     sinc_terms(theta, &gap_of, &q);
     return 4.0 / q;
 }
 
-double wc_buckling_energy(double d, double l, double R)
+double wci_buckling_energy(double d, double l, double R)
 {
     if (!(d < l)) return 0.0;
-    double theta = wc_inverse_sinc_gap((l - d) / l);
+    double theta = wci_inverse_sinc_gap((l - d) / l);
     return 2.0 * R * theta * theta / l;
 }
 
-double wc_buckling_energy_ramped(double d, double l, double R)
+double wci_buckling_energy_ramped(double d, double l, double R)
 {
     if (!(d < l)) return 0.0;
     double gap = (l - d) / l, ramp = WC_BUCKLING_ONSET_RAMP;
@@ -114,5 +114,5 @@ double wc_buckling_energy_ramped(double d, double l, double R)
     double f_end = R / (l * l) * wc_buckling_phi_of_gap(ramp);
     if (gap < ramp) return 0.5 * f_end * gap * gap / ramp * l;
     double ramp_energy = 0.5 * f_end * ramp * l;
-    return ramp_energy + wc_buckling_energy(d, l, R) - wc_buckling_energy((1.0 - ramp) * l, l, R);
+    return ramp_energy + wci_buckling_energy(d, l, R) - wci_buckling_energy((1.0 - ramp) * l, l, R);
 }

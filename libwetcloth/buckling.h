@@ -15,13 +15,13 @@
 /// theta in [0, pi] with 1 - sin(theta)/theta = gap, for gap in [0, 1].
 /// Taking the gap 1 - r rather than r keeps full precision near onset, where
 /// theta ~ sqrt(6 gap) and 1 - r would lose digits.
-double wc_inverse_sinc_gap(double gap);
+double wci_inverse_sinc_gap(double gap);
 
 /// theta in [0, pi] with sin(theta)/theta = r, for r in [0, 1].
-double wc_inverse_sinc(double r);
+double wci_inverse_sinc(double r);
 
 /// Normalised force Phi(theta) = 4 theta^2 / (sinc theta - cos theta).
-double wc_buckling_phi(double theta);
+double wci_buckling_phi(double theta);
 
 /// Piecewise polynomial table of Phi as a function of the gap t = 1 - d/l:
 /// piece k covers [k, k+1] / WC_BUCKLING_PIECES in t, with local variable
@@ -59,7 +59,7 @@ static inline double wc_buckling_force(double d, double l, double R)
 }
 
 /// Stored energy, J: 2 R theta^2 / l for d < l, zero otherwise.
-double wc_buckling_energy(double d, double l, double R);
+double wci_buckling_energy(double d, double l, double R);
 
 /// Compression (as a fraction of the rest length) over which the simulation
 /// ramps the buckling force in, linearly from 0 at d = l to the exact
@@ -92,7 +92,7 @@ static inline double wc_buckling_force_ramped(double d, double l, double R)
 }
 
 /// Energy whose gradient is wc_buckling_force_ramped, J.
-double wc_buckling_energy_ramped(double d, double l, double R);
+double wci_buckling_energy_ramped(double d, double l, double R);
 
 /// |d force / d d| <= WC_BUCKLING_STIFFNESS_BOUND_RAMPED * R / l^3 for the
 /// ramped force: the ramp's slope Phi(ramp) / ramp = 12007.2 (Phi at a gap of

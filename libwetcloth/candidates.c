@@ -26,21 +26,20 @@
 /* A margin covers this many times the motion expected until the frame ends. */
 #define MARGIN_AHEAD 1.5
 
-void wc_candidates_init(wc_candidates *c) { memset(c, 0, sizeof *c); }
 
 static void lists_free(wc_pair_lists *l)
 {
-    wc_free(l->start), wc_free(l->count), wc_free(l->room), wc_free(l->path_at);
-    wc_free(l->least), wc_free(l->snap), wc_free(l->item), wc_free(l->d);
+    wci_free(l->start), wci_free(l->count), wci_free(l->room), wci_free(l->path_at);
+    wci_free(l->least), wci_free(l->snap), wci_free(l->item), wci_free(l->d);
     memset(l, 0, sizeof *l);
 }
 
-void wc_candidates_free(wc_candidates *c)
+void wci_candidates_destroy(wc_candidates *c)
 {
-    wc_free(c->base), wc_free(c->margin), wc_free(c->base_path), wc_free(c->base_length);
+    wci_free(c->base), wci_free(c->margin), wci_free(c->base_path), wci_free(c->base_length);
     lists_free(&c->particles), lists_free(&c->triangles), lists_free(&c->edges);
-    wc_free(c->vertex_seen), wc_free(c->edge_seen), wc_free(c->found), wc_free(c->gathered), wc_free(c->gathered_d0);
-    wc_candidates_init(c);
+    wci_free(c->vertex_seen), wci_free(c->edge_seen), wci_free(c->found), wci_free(c->gathered), wci_free(c->gathered_d0);
+    memset(c, 0, sizeof *c);
 }
 
 static int lists_init(wc_pair_lists *l, int32_t owners, int per)
@@ -49,12 +48,12 @@ static int lists_init(wc_pair_lists *l, int32_t owners, int per)
     size_t n = owners > 0 ? (size_t)owners : 1;
     l->owner_count = owners;
     l->per = per;
-    l->start = wc_alloc_array(n, sizeof *l->start);
-    l->count = wc_alloc_array(n, sizeof *l->count);
-    l->room = wc_alloc_array(n, sizeof *l->room);
-    l->path_at = wc_alloc_array(n, sizeof *l->path_at);
-    l->least = wc_alloc_array(n, sizeof *l->least);
-    l->snap = wc_alloc_array(n * (size_t)(per > 0 ? per : 1), sizeof *l->snap);
+    l->start = wci_alloc_array(n, sizeof *l->start);
+    l->count = wci_alloc_array(n, sizeof *l->count);
+    l->room = wci_alloc_array(n, sizeof *l->room);
+    l->path_at = wci_alloc_array(n, sizeof *l->path_at);
+    l->least = wci_alloc_array(n, sizeof *l->least);
+    l->snap = wci_alloc_array(n * (size_t)(per > 0 ? per : 1), sizeof *l->snap);
     return l->start && l->count && l->room && l->path_at && l->least && l->snap;
 }
 
@@ -62,10 +61,10 @@ static int lists_init(wc_pair_lists *l, int32_t owners, int per)
  * dropping the garbage. */
 static int lists_repack(wc_pair_lists *l, int64_t capacity)
 {
-    int32_t *item = wc_alloc_array((size_t)capacity, sizeof *item);
-    double *d = wc_alloc_array((size_t)capacity, sizeof *d);
+    int32_t *item = wci_alloc_array((size_t)capacity, sizeof *item);
+    double *d = wci_alloc_array((size_t)capacity, sizeof *d);
     if (!item || !d) {
-        wc_free(item), wc_free(d);
+        wci_free(item), wci_free(d);
         return 0;
     }
     int64_t at = 0;
@@ -78,7 +77,7 @@ static int lists_repack(wc_pair_lists *l, int64_t capacity)
         l->room[k] = l->count[k];
         at += l->count[k];
     }
-    wc_free(l->item), wc_free(l->d);
+    wci_free(l->item), wci_free(l->d);
     l->item = item, l->d = d;
     l->used = at, l->capacity = capacity, l->garbage = 0;
     return 1;
@@ -123,25 +122,25 @@ static void vertex_of(const double *xyz, int32_t v, double out[3])
     out[0] = xyz[3 * (size_t)v], out[1] = xyz[3 * (size_t)v + 1], out[2] = xyz[3 * (size_t)v + 2];
 }
 
-double wc_candidates_particle_distance(const wc_collider *col, int32_t t, const double p[3])
+double wci_candidates_particle_distance(const wc_collider *col, int32_t t, const double p[3])
 {
     const int32_t *v = col->triangles + 3 * (size_t)t;
     double a[3], b[3], c[3], w[3];
     vertex_of(col->current, v[0], a), vertex_of(col->current, v[1], b), vertex_of(col->current, v[2], c);
-    return sqrt(wc_point_triangle_closest(p, a, b, c, w));
+    return sqrt(wci_point_triangle_closest(p, a, b, c, w));
 }
 
 /* Collider triangles whose boxes meet `box`, into c->found (grown as
  * needed). -1 on out-of-memory. */
 static int32_t query(wc_candidates *c, const wc_bvh *bvh, const double box[6])
 {
-    int32_t n = wc_bvh_collect(bvh, box, c->found, c->found_capacity);
+    int32_t n = wci_bvh_collect(bvh, box, c->found, c->found_capacity);
     if (n <= c->found_capacity) return n;
-    int32_t *grown = wc_alloc_array((size_t)n, 2 * sizeof *grown);
+    int32_t *grown = wci_alloc_array((size_t)n, 2 * sizeof *grown);
     if (!grown) return -1;
-    wc_free(c->found);
+    wci_free(c->found);
     c->found = grown, c->found_capacity = 2 * n;
-    return wc_bvh_collect(bvh, box, c->found, c->found_capacity);
+    return wci_bvh_collect(bvh, box, c->found, c->found_capacity);
 }
 
 /* Scratch for one owner's pairs: `n` ids and distances. */
@@ -182,14 +181,14 @@ static pair_entry *entries(wc_candidates *c, int64_t n, pair_entry **buf, int64_
 {
     if (*buf && n <= *cap && n <= c->gathered_capacity) return *buf;
     int64_t want = 2 * n + 64;
-    pair_entry *e = wc_alloc_array((size_t)want, sizeof *e);
-    int32_t *g = wc_alloc_array((size_t)want, sizeof *g);
-    double *d = wc_alloc_array((size_t)want, sizeof *d);
+    pair_entry *e = wci_alloc_array((size_t)want, sizeof *e);
+    int32_t *g = wci_alloc_array((size_t)want, sizeof *g);
+    double *d = wci_alloc_array((size_t)want, sizeof *d);
     if (!e || !g || !d) {
-        wc_free(e), wc_free(g), wc_free(d);
+        wci_free(e), wci_free(g), wci_free(d);
         return NULL;
     }
-    wc_free(*buf), wc_free(c->gathered), wc_free(c->gathered_d0);
+    wci_free(*buf), wci_free(c->gathered), wci_free(c->gathered_d0);
     *buf = e, *cap = want;
     c->gathered = g, c->gathered_d0 = d, c->gathered_capacity = want;
     return e;
@@ -235,7 +234,7 @@ static int particle_list(wc_candidates *c, scratch *s, const wc_collider *col, c
     if (!e) return 0;
     int32_t kept = 0;
     for (int32_t k = 0; k < n; ++k) {
-        double d = wc_candidates_particle_distance(col, c->found[k], p);
+        double d = wci_candidates_particle_distance(col, c->found[k], p);
         if (d <= reach) e[kept].d0 = d, e[kept].item = c->found[k], ++kept;
     }
     return keep_sorted(c, &c->particles, i, e, kept, c->base_path[i], c->base_length + i);
@@ -263,7 +262,7 @@ static int triangle_list(wc_candidates *c, scratch *s, const wc_cloth_elements *
             c->gathered[seen++] = v;
             double p[3], w[3];
             vertex_of(col->current, v, p);
-            double dist = sqrt(wc_point_triangle_closest(p, a, b, d, w));
+            double dist = sqrt(wci_point_triangle_closest(p, a, b, d, w));
             if (dist <= reach) e[kept].d0 = dist, e[kept].item = v, ++kept;
         }
     for (int32_t k = 0; k < seen; ++k) c->vertex_seen[c->gathered[k]] = 0;
@@ -319,7 +318,7 @@ static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, 
              * the cloth edge than its midpoint's distance less half its
              * length */
             if (segment_lower_bound(p, q, a, b) > reach) continue;
-            double dist = sqrt(wc_segment_segment_closest(p, q, a, b, &u, &v));
+            double dist = sqrt(wci_segment_segment_closest(p, q, a, b, &u, &v));
             if (dist <= reach) e[kept].d0 = dist, e[kept].item = f, ++kept;
         }
     for (int32_t k = 0; k < seen; ++k) c->edge_seen[c->gathered[k]] = 0;
@@ -336,7 +335,7 @@ static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, 
  * their queries sweep much of it (measured: the soaked 2 m cloth falling
  * past the sphere spent most of its step making lists); a rebase far from
  * everything costs a query that stops at the tree's root. */
-double wc_candidates_displacement(const wc_candidates *c, const wc_particle_arrays *p, int32_t i)
+double wci_candidates_displacement(const wc_candidates *c, const wc_particle_arrays *p, int32_t i)
 {
     const double *b = c->base + 3 * (size_t)i;
     double s[3] = {p->x[i] - b[0], p->y[i] - b[1], p->z[i] - b[2]};
@@ -370,16 +369,16 @@ static int allocate(wc_candidates *c, const wc_cloth_elements *el, const wc_coll
 {
     size_t n = el->particle_count > 0 ? (size_t)el->particle_count : 1;
     /* each made once; a failed call leaves the others for the retry */
-    if (!c->base) c->base = wc_alloc_array(3 * n, sizeof *c->base);
-    if (!c->margin) c->margin = wc_alloc_array(n, sizeof *c->margin);
-    if (!c->base_path) c->base_path = wc_alloc_array(n, sizeof *c->base_path);
-    if (!c->base_length) c->base_length = wc_alloc_array(n, sizeof *c->base_length);
-    if (!c->vertex_seen) c->vertex_seen = wc_alloc_array((size_t)col->vertex_count, 1);
-    if (!c->edge_seen) c->edge_seen = wc_alloc_array((size_t)col->edge_count + 1, 1);
+    if (!c->base) c->base = wci_alloc_array(3 * n, sizeof *c->base);
+    if (!c->margin) c->margin = wci_alloc_array(n, sizeof *c->margin);
+    if (!c->base_path) c->base_path = wci_alloc_array(n, sizeof *c->base_path);
+    if (!c->base_length) c->base_length = wci_alloc_array(n, sizeof *c->base_length);
+    if (!c->vertex_seen) c->vertex_seen = wci_alloc_array((size_t)col->vertex_count, 1);
+    if (!c->edge_seen) c->edge_seen = wci_alloc_array((size_t)col->edge_count + 1, 1);
     return c->base && c->margin && c->base_path && c->base_length && c->vertex_seen && c->edge_seen;
 }
 
-wc_status wc_candidates_build(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
                               double r, const wc_particle_arrays *p, const wc_particle_paths *paths,
                               int32_t steps_left)
 {
@@ -394,7 +393,7 @@ wc_status wc_candidates_build(wc_candidates *c, const wc_cloth_elements *el, con
     for (int32_t i = 0; i < el->particle_count && ok; ++i) ok = particle_list(c, &s, col, bvh, i);
     for (int32_t t = 0; t < el->triangle_count && ok; ++t) ok = triangle_list(c, &s, el, col, bvh, t, col->path);
     for (int32_t e = 0; e < el->edge_count && ok; ++e) ok = edge_list(c, &s, el, col, bvh, e, col->path);
-    wc_free(s.e);
+    wci_free(s.e);
     if (!ok) {
         c->r = 0.0; /* made again at the next use */
         return WC_ERROR_OUT_OF_MEMORY;
@@ -402,7 +401,7 @@ wc_status wc_candidates_build(wc_candidates *c, const wc_cloth_elements *el, con
     return WC_OK;
 }
 
-wc_status wc_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
                                const int32_t *particles, int32_t count, const wc_particle_arrays *p,
                                const wc_particle_paths *paths, int32_t steps_left, uint8_t *mark)
 {
@@ -426,7 +425,7 @@ wc_status wc_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, co
         for (int32_t k = 0; k < count; ++k)
             for (int32_t j = start[particles[k]]; j < start[particles[k] + 1]; ++j) mark[items[j]] = 0;
     }
-    wc_free(s.e);
+    wci_free(s.e);
     if (!ok) {
         c->r = 0.0;
         return WC_ERROR_OUT_OF_MEMORY;
@@ -434,7 +433,7 @@ wc_status wc_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, co
     return WC_OK;
 }
 
-double wc_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
+double wci_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
                            const wc_particle_paths *paths)
 {
     const double *snap = l->snap + (size_t)l->per * (size_t)k;
@@ -450,7 +449,7 @@ double wc_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *par
     return most;
 }
 
-void wc_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
+void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
                          const wc_particle_paths *paths, double collider_path,
                          const uint8_t *tested, const double *measured, double drift_end)
 {

@@ -108,8 +108,7 @@ typedef struct wc_cloth_elements {
     int32_t *triangles_start, *triangles_of, *edges_start, *edges_of;
 } wc_cloth_elements;
 
-void wc_candidates_init(wc_candidates *cand);
-void wc_candidates_free(wc_candidates *cand);
+void wci_candidates_destroy(wc_candidates *cand);
 
 /// Whether particle i, at displacement `d` from its base with the collider
 /// at `path`, is still covered by its lists: what is unlisted stays beyond
@@ -130,13 +129,13 @@ static inline int wc_candidates_half_used(const wc_candidates *cand, int32_t i, 
 
 /// Particle i's distance from its base: the larger at the start (x) and at
 /// the end (nx) of the step, which by convexity bounds it over the step.
-double wc_candidates_displacement(const wc_candidates *cand, const wc_particle_arrays *p, int32_t i);
+double wci_candidates_displacement(const wc_candidates *cand, const wc_particle_arrays *p, int32_t i);
 
 /// Makes every list (first use, or the contact distance changed), with
 /// every particle rebased at its start-of-step position; `steps_left` is
 /// how many steps of the running frame follow this one (margins).
 /// WC_ERROR_OUT_OF_MEMORY on failure.
-wc_status wc_candidates_build(wc_candidates *cand, const wc_cloth_elements *el,
+wc_status wci_candidates_update(wc_candidates *cand, const wc_cloth_elements *el,
                               const wc_collider *col, double r, const wc_particle_arrays *p,
                               const wc_particle_paths *paths, int32_t steps_left);
 
@@ -144,14 +143,14 @@ wc_status wc_candidates_build(wc_candidates *cand, const wc_cloth_elements *el,
 /// position and a new margin) and makes their lists and those of their
 /// triangles and edges again. `mark` is per-element scratch (zero, left
 /// zero), sized for the larger of the cloth's triangle and edge counts.
-wc_status wc_candidates_rebase(wc_candidates *cand, const wc_cloth_elements *el,
+wc_status wci_candidates_rebase(wc_candidates *cand, const wc_cloth_elements *el,
                                const wc_collider *col, const int32_t *particles, int32_t count,
                                const wc_particle_arrays *p, const wc_particle_paths *paths,
                                int32_t steps_left, uint8_t *mark);
 
 /// How far owner k's particles can be from where they were at its
 /// snapshot, over the step (starts and ends).
-double wc_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
+double wci_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
                            const wc_particle_paths *paths);
 
 /// After a visit of owner k that moved nothing: its snapshot renewed at its
@@ -159,12 +158,12 @@ double wc_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *par
 /// whether item j was measured, at distance measured[j]; the others keep
 /// their bound less `drift_end` (how far owner and collider can have moved
 /// from the old snapshot to now).
-void wc_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
+void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
                          const wc_particle_paths *paths, double collider_path,
                          const uint8_t *tested, const double *measured, double drift_end);
 
 /// Distance from a point to a collider triangle, vertex and edge in the
 /// collider's current positions (what the lists' d0 are measured in).
-double wc_candidates_particle_distance(const wc_collider *col, int32_t triangle, const double p[3]);
+double wci_candidates_particle_distance(const wc_collider *col, int32_t triangle, const double p[3]);
 
 #endif

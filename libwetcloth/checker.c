@@ -63,8 +63,8 @@ static int between2d(const double a[2], const double b[2], const double c[2])
  * a segment may be a point). */
 static int segments_meet2d(const double a[2], const double b[2], const double c[2], const double d[2])
 {
-    int o1 = wc_orient2d(a, b, c), o2 = wc_orient2d(a, b, d);
-    int o3 = wc_orient2d(c, d, a), o4 = wc_orient2d(c, d, b);
+    int o1 = wci_orient2d(a, b, c), o2 = wci_orient2d(a, b, d);
+    int o3 = wci_orient2d(c, d, a), o4 = wci_orient2d(c, d, b);
     if (o1 * o2 < 0 && o3 * o4 < 0) return 1;
     return (o1 == 0 && between2d(a, b, c)) || (o2 == 0 && between2d(a, b, d)) ||
            (o3 == 0 && between2d(c, d, a)) || (o4 == 0 && between2d(c, d, b));
@@ -73,7 +73,7 @@ static int segments_meet2d(const double a[2], const double b[2], const double c[
 /* p inside or on the 2D triangle (a, b, c) of either orientation. */
 static int inside2d(const double p[2], const double a[2], const double b[2], const double c[2])
 {
-    int o1 = wc_orient2d(a, b, p), o2 = wc_orient2d(b, c, p), o3 = wc_orient2d(c, a, p);
+    int o1 = wci_orient2d(a, b, p), o2 = wci_orient2d(b, c, p), o3 = wci_orient2d(c, a, p);
     return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
 }
 
@@ -109,7 +109,7 @@ static int degenerate(const double *const t[3])
     for (int drop = 0; drop < 3; ++drop) {
         double a[2], b[2], c[2];
         project(t[0], drop, a), project(t[1], drop, b), project(t[2], drop, c);
-        if (wc_orient2d(a, b, c) != 0) return 0;
+        if (wci_orient2d(a, b, c) != 0) return 0;
     }
     return 1;
 }
@@ -119,7 +119,7 @@ static int degenerate(const double *const t[3])
  * of them keeps their plane (or line) undistorted. */
 static int segments_meet3d(const double a[3], const double b[3], const double c[3], const double d[3])
 {
-    if (wc_orient3d(a, b, c, d) != 0) return 0;
+    if (wci_orient3d(a, b, c, d) != 0) return 0;
     for (int drop = 0; drop < 3; ++drop) {
         double A[2], B[2], C[2], D[2];
         project(a, drop, A), project(b, drop, B), project(c, drop, C), project(d, drop, D);
@@ -131,7 +131,7 @@ static int segments_meet3d(const double a[3], const double b[3], const double c[
 /* Closed segment a-b (maybe a point) meets the non-degenerate triangle t. */
 static int segment_meets_triangle(const double a[3], const double b[3], const double *const t[3])
 {
-    int sa = wc_orient3d(t[0], t[1], t[2], a), sb = wc_orient3d(t[0], t[1], t[2], b);
+    int sa = wci_orient3d(t[0], t[1], t[2], a), sb = wci_orient3d(t[0], t[1], t[2], b);
     if (sa * sb > 0) return 0;
     if (sa == 0 && sb == 0) {
         int drop = drop_axis(t);
@@ -144,8 +144,8 @@ static int segment_meets_triangle(const double a[3], const double b[3], const do
     }
     /* it reaches the plane: where it does must be in the triangle, that is
      * the line a-b passes t's three edges on the same side */
-    int s1 = wc_orient3d(a, b, t[0], t[1]), s2 = wc_orient3d(a, b, t[1], t[2]);
-    int s3 = wc_orient3d(a, b, t[2], t[0]);
+    int s1 = wci_orient3d(a, b, t[0], t[1]), s2 = wci_orient3d(a, b, t[1], t[2]);
+    int s3 = wci_orient3d(a, b, t[2], t[0]);
     return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
 }
 
@@ -172,8 +172,8 @@ static int degenerate_pair(const double *const p[3], const double *const q[3], i
 static int intervals_overlap(const double *p1, const double *q1, const double *r1, const double *p2,
                              const double *q2, const double *r2)
 {
-    if (wc_orient3d(q1, p2, p1, q2) > 0) return 0;
-    if (wc_orient3d(p1, p2, r1, r2) > 0) return 0;
+    if (wci_orient3d(q1, p2, p1, q2) > 0) return 0;
+    if (wci_orient3d(p1, p2, r1, r2) > 0) return 0;
     return 1;
 }
 
@@ -206,7 +206,7 @@ static int second_alone(const double *p1, const double *q1, const double *r1, co
     return coplanar_triangles(tp, tq, drop);
 }
 
-int wc_triangles_intersect(const double p0[3], const double p1[3], const double p2[3],
+int wci_triangles_intersect(const double p0[3], const double p1[3], const double p2[3],
                            const double q0[3], const double q1[3], const double q2[3])
 {
     const double *const p[3] = {p0, p1, p2};
@@ -219,11 +219,11 @@ int wc_triangles_intersect(const double p0[3], const double p1[3], const double 
     }
     int p_flat = degenerate(p), q_flat = degenerate(q);
     if (p_flat || q_flat) return degenerate_pair(p, q, p_flat, q_flat);
-    int dp1 = wc_orient3d(q0, q1, q2, p0), dq1 = wc_orient3d(q0, q1, q2, p1);
-    int dr1 = wc_orient3d(q0, q1, q2, p2);
+    int dp1 = wci_orient3d(q0, q1, q2, p0), dq1 = wci_orient3d(q0, q1, q2, p1);
+    int dr1 = wci_orient3d(q0, q1, q2, p2);
     if (dp1 * dq1 > 0 && dp1 * dr1 > 0) return 0;
-    int dp2 = wc_orient3d(p0, p1, p2, q0), dq2 = wc_orient3d(p0, p1, p2, q1);
-    int dr2 = wc_orient3d(p0, p1, p2, q2);
+    int dp2 = wci_orient3d(p0, p1, p2, q0), dq2 = wci_orient3d(p0, p1, p2, q1);
+    int dr2 = wci_orient3d(p0, p1, p2, q2);
     if (dp2 * dq2 > 0 && dp2 * dr2 > 0) return 0;
     int drop = drop_axis(p);
     /* p0 made alone on its side of q's plane, q's order flipped when p0 is
@@ -321,13 +321,13 @@ static int test_pair(const wc_world *w, const item *a, const item *b)
                     if (ta[i] == tb[j]) return 0; /* neighbours share a vertex */
         double pb[3][3];
         for (int i = 0; i < 3; ++i) cloth_vertex(cb, tb[i], pb[i]);
-        return wc_triangles_intersect(pa[0], pa[1], pa[2], pb[0], pb[1], pb[2]) ? 1 : 0;
+        return wci_triangles_intersect(pa[0], pa[1], pa[2], pb[0], pb[1], pb[2]) ? 1 : 0;
     }
     const wc_collider *c = w->colliders[-1 - b->owner];
     if (!c->is_mesh)
-        return wc_convex_triangle_intersects(&c->convex, &c->pose_current, pa[0], pa[1], pa[2]) ? 2 : 0;
+        return wci_convex_triangle_intersects(&c->convex, &c->pose_current, pa[0], pa[1], pa[2]) ? 2 : 0;
     const int32_t *tb = c->triangles + 3 * (size_t)b->tri;
-    return wc_triangles_intersect(pa[0], pa[1], pa[2], c->current + 3 * (size_t)tb[0],
+    return wci_triangles_intersect(pa[0], pa[1], pa[2], c->current + 3 * (size_t)tb[0],
                                   c->current + 3 * (size_t)tb[1], c->current + 3 * (size_t)tb[2])
                ? 2
                : 0;
@@ -352,9 +352,9 @@ static int overlap(const item *a, const item *b, int axis)
 wc_status wc_world_count_intersections(const wc_world *world, wc_intersection_counts *out)
 {
     if (!world) return WC_ERROR_INVALID_ARGUMENT;
-    wc_message *msg = wc_world_message(world);
+    wc_message *msg = wci_world_message(world);
     if (!out)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "wc_world_count_intersections: out_counts is NULL");
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "wc_world_count_intersections: out_counts is NULL");
 
     /* Gather the boxes. */
     int64_t n64 = 0;
@@ -362,13 +362,13 @@ wc_status wc_world_count_intersections(const wc_world *world, wc_intersection_co
     for (int32_t c = 0; c < world->collider_count; ++c)
         n64 += world->colliders[c]->is_mesh ? world->colliders[c]->triangle_count : 1;
     if (n64 > INT32_MAX / 4)
-        return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY,
+        return wci_fail(msg, WC_ERROR_OUT_OF_MEMORY,
                        "wc_world_count_intersections: %lld triangles are too many to check",
                        (long long)n64);
     int32_t n = (int32_t)n64;
-    item *items = wc_alloc_array((size_t)n, sizeof *items);
+    item *items = wci_alloc_array((size_t)n, sizeof *items);
     if (!items)
-        return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY,
+        return wci_fail(msg, WC_ERROR_OUT_OF_MEMORY,
                        "wc_world_count_intersections: out of memory for %d boxes", (int)n);
     int32_t m = 0;
     for (int32_t c = 0; c < world->cloth_count; ++c) {
@@ -453,19 +453,19 @@ wc_status wc_world_count_intersections(const wc_world *world, wc_intersection_co
     if (bands <= 1) copies = n;
     double bw = bands > 1 ? span / (double)bands : 1.0;
 
-    int64_t *start = wc_alloc_array((size_t)bands + 1, sizeof *start);
-    int64_t *fill = wc_alloc_array((size_t)bands, sizeof *fill);
-    int32_t *first_band = wc_alloc_array((size_t)n, sizeof *first_band);
-    key_id *order = wc_alloc_array((size_t)n, sizeof *order);
-    key_id *members = wc_alloc_array((size_t)copies, sizeof *members);
+    int64_t *start = wci_alloc_array((size_t)bands + 1, sizeof *start);
+    int64_t *fill = wci_alloc_array((size_t)bands, sizeof *fill);
+    int32_t *first_band = wci_alloc_array((size_t)n, sizeof *first_band);
+    key_id *order = wci_alloc_array((size_t)n, sizeof *order);
+    key_id *members = wci_alloc_array((size_t)copies, sizeof *members);
     if (!start || !fill || !first_band || !order || !members) {
-        wc_free(items);
-        wc_free(start);
-        wc_free(fill);
-        wc_free(first_band);
-        wc_free(order);
-        wc_free(members);
-        return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY,
+        wci_free(items);
+        wci_free(start);
+        wci_free(fill);
+        wci_free(first_band);
+        wci_free(order);
+        wci_free(members);
+        return wci_fail(msg, WC_ERROR_OUT_OF_MEMORY,
                        "wc_world_count_intersections: out of memory for %lld band entries",
                        (long long)copies);
     }
@@ -498,7 +498,7 @@ wc_status wc_world_count_intersections(const wc_world *world, wc_intersection_co
      * ends. Bands are independent, so they run in parallel; the counts are
      * integers, so the sum does not depend on the thread count. */
     int64_t cloth_cloth = 0, cloth_collider = 0;
-    int threads = wc_thread_count(world->def.thread_count);
+    int threads = wci_thread_count(world->def.thread_count);
     (void)threads;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (n >= 4096) \
     reduction(+ : cloth_cloth, cloth_collider)
@@ -519,12 +519,12 @@ wc_status wc_world_count_intersections(const wc_world *world, wc_intersection_co
             }
         }
     }
-    wc_free(items);
-    wc_free(start);
-    wc_free(fill);
-    wc_free(first_band);
-    wc_free(order);
-    wc_free(members);
+    wci_free(items);
+    wci_free(start);
+    wci_free(fill);
+    wci_free(first_band);
+    wci_free(order);
+    wci_free(members);
     out->cloth_cloth = cloth_cloth > INT32_MAX ? INT32_MAX : (int32_t)cloth_cloth;
     out->cloth_collider = cloth_collider > INT32_MAX ? INT32_MAX : (int32_t)cloth_collider;
     return WC_OK;

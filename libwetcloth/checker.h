@@ -8,7 +8,7 @@
 #include "wetcloth.h"
 
 /// Whether triangles (p0, p1, p2) and (q0, q1, q2) intersect (touching counts).
-int wc_triangles_intersect(const double p0[3], const double p1[3], const double p2[3],
+int wci_triangles_intersect(const double p0[3], const double p1[3], const double p2[3],
                            const double q0[3], const double q1[3], const double q2[3]);
 
 #endif

@@ -8,7 +8,7 @@
 #define WIN32_LEAN_AND_MEAN
 #include <windows.h>
 
-double wc_clock_seconds(void)
+double wci_clock_seconds(void)
 {
     LARGE_INTEGER frequency, count;
     if (!QueryPerformanceFrequency(&frequency) || !QueryPerformanceCounter(&count)) return 0.0;
@@ -17,7 +17,7 @@ double wc_clock_seconds(void)
 #else
 #include <time.h>
 
-double wc_clock_seconds(void)
+double wci_clock_seconds(void)
 {
     struct timespec t;
     if (clock_gettime(CLOCK_MONOTONIC, &t) != 0) return 0.0;

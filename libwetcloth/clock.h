@@ -3,6 +3,6 @@
 #define WC_CLOCK_H
 
 /// Seconds on a monotonic clock, from an arbitrary origin.
-double wc_clock_seconds(void);
+double wci_clock_seconds(void);
 
 #endif

@@ -11,7 +11,7 @@
 #include "status.h"
 #include "xpbd.h"
 
-void wc_cloth_destroy(wc_cloth *c)
+void wci_cloth_destroy(wc_cloth *c)
 {
     if (!c) return;
     double *arrays[] = {c->x,  c->y,  c->z,  c->px,      c->py,      c->pz,      c->nx,
@@ -22,30 +22,30 @@ void wc_cloth_destroy(wc_cloth *c)
                         c->normal_x, c->normal_y, c->normal_z, c->qx, c->qy, c->qz,
                         c->wetness, c->wetness_next, c->pins.stiffness, c->air_velocity,
                         c->external_force};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
-    wc_free(c->link_start);
-    wc_free(c->link_list);
-    wc_free(c->pin_slot);
-    wc_free(c->soft_pin_slot);
-    wc_free(c->pins.particle);
-    wc_free(c->contact);
-    wc_free(c->contact_prev);
-    wc_free(c->stuck);
-    wc_free(c->history_override);
-    wc_free(c->self_touched);
-    wc_free(c->adhesive_pairs);
-    wc_free(c->adhesive_data);
-    wc_self_state_destroy(c->self);
-    wc_collider_contacts_destroy(c->collider_contacts);
-    wc_xpbd_state_destroy(c->xpbd);
-    wc_implicit_state_destroy(c->implicit);
-    wc_topology_free(&c->topology);
-    wc_free(c);
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wci_free(arrays[i]);
+    wci_free(c->link_start);
+    wci_free(c->link_list);
+    wci_free(c->pin_slot);
+    wci_free(c->soft_pin_slot);
+    wci_free(c->pins.particle);
+    wci_free(c->contact);
+    wci_free(c->contact_prev);
+    wci_free(c->stuck);
+    wci_free(c->history_override);
+    wci_free(c->self_touched);
+    wci_free(c->adhesive_pairs);
+    wci_free(c->adhesive_data);
+    wci_self_state_destroy(c->self);
+    wci_collider_contacts_destroy(c->collider_contacts);
+    wci_xpbd_state_destroy(c->xpbd);
+    wci_implicit_state_destroy(c->implicit);
+    wci_topology_destroy(&c->topology);
+    wci_free(c);
 }
 
 static int alloc_doubles(double **p, size_t count)
 {
-    *p = wc_alloc_array(count, sizeof **p);
+    *p = wci_alloc_array(count, sizeof **p);
     return *p != NULL;
 }
 
@@ -69,16 +69,16 @@ static int alloc_particle_arrays(wc_cloth *c)
         ok &= alloc_doubles(&c->vx, n) & alloc_doubles(&c->vy, n) & alloc_doubles(&c->vz, n);
     if (c->material.stretch_damping > 0.0)
         ok &= alloc_doubles(&c->stretch_c, (size_t)c->topology.stretch.count);
-    c->link_start = wc_alloc_array(n + 1, sizeof *c->link_start);
-    c->link_list = wc_alloc_array(2 * links, sizeof *c->link_list);
-    c->pin_slot = wc_alloc_array(n, sizeof *c->pin_slot);
+    c->link_start = wci_alloc_array(n + 1, sizeof *c->link_start);
+    c->link_list = wci_alloc_array(2 * links, sizeof *c->link_list);
+    c->pin_slot = wci_alloc_array(n, sizeof *c->pin_slot);
     ok &= alloc_doubles(&c->normal_x, n) & alloc_doubles(&c->normal_y, n) &
           alloc_doubles(&c->normal_z, n) & alloc_doubles(&c->qx, n) & alloc_doubles(&c->qy, n) &
           alloc_doubles(&c->qz, n);
-    c->contact = wc_alloc_array(n, sizeof *c->contact);
-    c->contact_prev = wc_alloc_array(n, sizeof *c->contact_prev);
-    c->stuck = wc_alloc_array(n, sizeof *c->stuck);
-    c->history_override = wc_alloc_array(n, sizeof *c->history_override);
+    c->contact = wci_alloc_array(n, sizeof *c->contact);
+    c->contact_prev = wci_alloc_array(n, sizeof *c->contact_prev);
+    c->stuck = wci_alloc_array(n, sizeof *c->stuck);
+    c->history_override = wci_alloc_array(n, sizeof *c->history_override);
     ok &= alloc_doubles(&c->wetness, n);
     if (c->material.wicking > 0.0) ok &= alloc_doubles(&c->wetness_next, n);
     return ok && c->link_start && c->link_list && c->pin_slot && c->contact && c->contact_prev &&
@@ -198,12 +198,12 @@ static stable_mode mode_of(wc_integrator integrator)
 }
 
 
-void wc_cloth_update_stable_dt(wc_cloth *c)
+void wci_cloth_update_stable_dt(wc_cloth *c)
 {
     c->stable_dt = estimate_stable_dt(c, mode_of(c->integrator));
 }
 
-void wc_cloth_set_integrator(wc_cloth *c, wc_integrator integrator)
+void wci_cloth_set_integrator(wc_cloth *c, wc_integrator integrator)
 {
     if (integrator == c->integrator) return; /* a new cloth starts as Verlet */
     c->integrator = integrator;
@@ -223,7 +223,7 @@ static int any_wet_force(const wc_cloth *c)
  * wetness included: mass * (1 + gain w), stiffness * (1 - softening w),
  * w a link's mean wetness. For w = 0 both factors are exactly 1, so a dry
  * cloth gets bitwise the plain model's constants. */
-void wc_cloth_apply_material(wc_cloth *c)
+void wci_cloth_apply_material(wc_cloth *c)
 {
     const wc_topology *t = &c->topology;
     const wc_material *m = &c->material;
@@ -260,29 +260,29 @@ static wc_status check_links(const wc_cloth *c, wc_message *msg)
     const wc_link_set *s = &c->topology.stretch;
     for (int32_t e = 0; e < s->count; ++e)
         if (!(s->rest[e] > 0.0))
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "cloth vertices %d and %d are linked but lie at the same point",
                            (int)s->a[e], (int)s->b[e]);
     return WC_OK;
 }
 
-wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const int32_t *faces,
+wc_status wci_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const int32_t *faces,
                           int32_t face_count, int32_t face_size, const wc_material *material,
                           int self_collision, double wetness, wc_message *msg)
 {
     *out = NULL;
-    wc_cloth *c = wc_alloc_array(1, sizeof *c);
-    if (!c) return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a cloth");
+    wc_cloth *c = wci_alloc_array(1, sizeof *c);
+    if (!c) return wci_fail(msg, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a cloth");
     c->particle_count = n;
     c->material = *material;
-    wc_status s = wc_topology_build(&c->topology, xyz, n, faces, face_count, face_size, msg);
+    wc_status s = wci_topology_create(&c->topology, xyz, n, faces, face_count, face_size, msg);
     if (s) {
-        wc_free(c);
+        wci_free(c);
         return s;
     }
     if (!alloc_particle_arrays(c)) {
-        wc_cloth_destroy(c);
-        return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a cloth of %d vertices",
+        wci_cloth_destroy(c);
+        return wci_fail(msg, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a cloth of %d vertices",
                        (int)n);
     }
     for (int32_t i = 0; i < n; ++i) {
@@ -292,26 +292,26 @@ wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t n, const in
     }
     build_link_lists(c);
     if (self_collision) {
-        c->self = wc_self_state_create(c);
+        c->self = wci_self_state_create(c);
         if (!c->self) {
-            wc_cloth_destroy(c);
-            return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY,
+            wci_cloth_destroy(c);
+            return wci_fail(msg, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory for the self-collision buffers of a cloth of %d vertices",
                            (int)n);
         }
     }
     s = check_links(c, msg);
     if (s) {
-        wc_cloth_destroy(c);
+        wci_cloth_destroy(c);
         return s;
     }
     for (int32_t i = 0; i < n; ++i) c->wetness[i] = wetness;
-    wc_cloth_apply_material(c);
+    wci_cloth_apply_material(c);
     *out = c;
     return WC_OK;
 }
 
-void wc_cloth_commit(wc_cloth *c, double dt, int with_overrides)
+void wci_cloth_commit(wc_cloth *c, double dt, int with_overrides)
 {
     double *t;
     t = c->px, c->px = c->x, c->x = c->nx, c->nx = t;
@@ -324,7 +324,7 @@ void wc_cloth_commit(wc_cloth *c, double dt, int with_overrides)
     c->dt_prev = dt;
 }
 
-void wc_cloth_velocity(const wc_cloth *c, int32_t i, double v[3])
+void wci_cloth_velocity(const wc_cloth *c, int32_t i, double v[3])
 {
     if (!c->has_history) {
         v[0] = c->px[i], v[1] = c->py[i], v[2] = c->pz[i];

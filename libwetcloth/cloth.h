@@ -146,31 +146,31 @@ typedef struct wc_cloth {
 } wc_cloth;
 
 /// Creates a cloth from a validated description. On failure nothing leaks.
-wc_status wc_cloth_create(wc_cloth **out, const double *xyz, int32_t vertex_count,
+wc_status wci_cloth_create(wc_cloth **out, const double *xyz, int32_t vertex_count,
                           const int32_t *faces, int32_t face_count, int32_t face_size,
                           const wc_material *material, int self_collision, double wetness,
                           wc_message *msg);
 
-void wc_cloth_destroy(wc_cloth *cloth);
+void wci_cloth_destroy(wc_cloth *cloth);
 
 /// Moves px/x/nx one step on after a successful step of length dt. With
 /// overrides, particles whose history_override is set get q as their
 /// previous position, which carries the velocity a collision gave them.
-void wc_cloth_commit(wc_cloth *cloth, double dt, int with_overrides);
+void wci_cloth_commit(wc_cloth *cloth, double dt, int with_overrides);
 
 /// Derives masses, link constants and the stable step from the material and
 /// the current wetness (see wc_material). Call after wetness changes.
-void wc_cloth_apply_material(wc_cloth *cloth);
+void wci_cloth_apply_material(wc_cloth *cloth);
 
 /// Sets the integrator that will step the cloth, and the stable step
 /// estimate with it.
-void wc_cloth_set_integrator(wc_cloth *cloth, wc_integrator integrator);
+void wci_cloth_set_integrator(wc_cloth *cloth, wc_integrator integrator);
 
 /// Recomputes the stable step estimate, after the explicit forces changed
 /// (soft pins added or released).
-void wc_cloth_update_stable_dt(wc_cloth *cloth);
+void wci_cloth_update_stable_dt(wc_cloth *cloth);
 
 /// Velocity of particle i, m/s (see wc_cloth_get_velocities).
-void wc_cloth_velocity(const wc_cloth *cloth, int32_t i, double v[3]);
+void wci_cloth_velocity(const wc_cloth *cloth, int32_t i, double v[3]);
 
 #endif

@@ -43,17 +43,17 @@ static wc_status append_cloth(wc_world *w, wc_cloth *c, int32_t *out_cloth)
 {
     if (w->cloth_count == w->cloth_capacity) {
         int32_t capacity = w->cloth_capacity ? 2 * w->cloth_capacity : 4;
-        wc_cloth **grown = wc_alloc_array((size_t)capacity, sizeof *grown);
+        wc_cloth **grown = wci_alloc_array((size_t)capacity, sizeof *grown);
         if (!grown) {
-            wc_cloth_destroy(c);
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a cloth");
+            wci_cloth_destroy(c);
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a cloth");
         }
         if (w->cloth_count) memcpy(grown, w->cloths, (size_t)w->cloth_count * sizeof *grown);
-        wc_free(w->cloths);
+        wci_free(w->cloths);
         w->cloths = grown;
         w->cloth_capacity = capacity;
     }
-    wc_cloth_set_integrator(c, w->def.integrator);
+    wci_cloth_set_integrator(c, w->def.integrator);
     w->cloths[w->cloth_count] = c;
     *out_cloth = w->cloth_count++;
     return WC_OK;
@@ -64,37 +64,37 @@ wc_status wc_world_add_mesh_cloth(wc_world *w, const wc_mesh_cloth_def *d, int32
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
     wc_message *msg = &w->error;
     if (!d || !out_cloth)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_mesh_cloth: %s is NULL",
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_mesh_cloth: %s is NULL",
                        d ? "out_cloth" : "def");
     if (d->vertex_count < 3 || d->vertex_count > MAX_VERTICES)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.vertex_count must be in [3, %d] but is %d", MAX_VERTICES,
                        (int)d->vertex_count);
     if (d->face_count < 1 || d->face_count > MAX_FACES)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.face_count must be in [1, %d] but is %d", MAX_FACES,
                        (int)d->face_count);
     if (d->face_size != 3 && d->face_size != 4)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.face_size must be 3 or 4 but is %d", (int)d->face_size);
     if (!d->vertices || !d->faces)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "mesh_cloth_def.%s is NULL",
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "mesh_cloth_def.%s is NULL",
                        d->vertices ? "faces" : "vertices");
     if (d->self_collision != 0 && d->self_collision != 1)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.self_collision must be 0 or 1 but is %d",
                        (int)d->self_collision);
     if (d->collide_with_cloths != 0 && d->collide_with_cloths != 1)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.collide_with_cloths must be 0 or 1 but is %d",
                        (int)d->collide_with_cloths);
     if (!(d->wetness >= 0.0 && d->wetness <= 1.0))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_cloth_def.wetness must be in [0, 1] but is %g", d->wetness);
-    wc_status s = wc_material_validate(&d->material, msg);
+    wc_status s = wci_material_validate(&d->material, msg);
     if (s) return s;
     wc_cloth *c;
-    s = wc_cloth_create(&c, d->vertices, d->vertex_count, d->faces, d->face_count, d->face_size,
+    s = wci_cloth_create(&c, d->vertices, d->vertex_count, d->faces, d->face_count, d->face_size,
                         &d->material, d->self_collision, d->wetness, msg);
     if (s) return s;
     c->collide_cloths = d->collide_with_cloths;
@@ -104,61 +104,61 @@ wc_status wc_world_add_mesh_cloth(wc_world *w, const wc_mesh_cloth_def *d, int32
 static wc_status validate_grid(const wc_grid_cloth_def *d, wc_message *msg)
 {
     if (d->count_u < 2 || d->count_u > 32768 || d->count_v < 2 || d->count_v > 32768)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.count_u and count_v must be in [2, 32768] but are %d and %d",
                        (int)d->count_u, (int)d->count_v);
     if ((int64_t)d->count_u * d->count_v > MAX_VERTICES)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def: count_u * count_v must be at most %d but is %lld",
                        MAX_VERTICES, (long long)d->count_u * d->count_v);
     if (!(isfinite(d->size_u) && d->size_u > 0 && d->size_u <= 1e6 && isfinite(d->size_v) &&
           d->size_v > 0 && d->size_v <= 1e6))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.size_u and size_v must be in (0, 1e6] m but are %g and %g",
                        d->size_u, d->size_v);
     double lu = 0, lv = 0, dot = 0;
     for (int k = 0; k < 3; ++k) {
         if (!isfinite(d->center[k]))
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "grid_cloth_def.center[%d] must be finite but is %g", k, d->center[k]);
         lu += d->axis_u[k] * d->axis_u[k];
         lv += d->axis_v[k] * d->axis_v[k];
         dot += d->axis_u[k] * d->axis_v[k];
     }
     if (!(fabs(lu - 1.0) <= 1e-6 && fabs(lv - 1.0) <= 1e-6 && fabs(dot) <= 1e-6))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.axis_u and axis_v must be perpendicular unit vectors but "
                        "have lengths %g and %g and dot product %g",
                        sqrt(lu), sqrt(lv), dot);
     if (d->self_collision != 0 && d->self_collision != 1)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.self_collision must be 0 or 1 but is %d",
                        (int)d->self_collision);
     if (d->collide_with_cloths != 0 && d->collide_with_cloths != 1)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.collide_with_cloths must be 0 or 1 but is %d",
                        (int)d->collide_with_cloths);
     if (!(d->wetness >= 0.0 && d->wetness <= 1.0))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "grid_cloth_def.wetness must be in [0, 1] but is %g", d->wetness);
-    return wc_material_validate(&d->material, msg);
+    return wci_material_validate(&d->material, msg);
 }
 
 wc_status wc_world_add_grid_cloth(wc_world *w, const wc_grid_cloth_def *d, int32_t *out_cloth)
 {
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
     if (!d || !out_cloth)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_grid_cloth: %s is NULL",
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_grid_cloth: %s is NULL",
                        d ? "out_cloth" : "def");
     wc_status s = validate_grid(d, &w->error);
     if (s) return s;
     int32_t nu = d->count_u, nv = d->count_v, n = nu * nv, quads = (nu - 1) * (nv - 1);
-    double *xyz = wc_alloc_array(3 * (size_t)n, sizeof *xyz);
-    int32_t *faces = wc_alloc_array(4 * (size_t)quads, sizeof *faces);
+    double *xyz = wci_alloc_array(3 * (size_t)n, sizeof *xyz);
+    int32_t *faces = wci_alloc_array(4 * (size_t)quads, sizeof *faces);
     if (!xyz || !faces) {
-        wc_free(xyz);
-        wc_free(faces);
-        return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory building a %d x %d grid",
+        wci_free(xyz);
+        wci_free(faces);
+        return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory building a %d x %d grid",
                        (int)nu, (int)nv);
     }
     for (int32_t j = 0; j < nv; ++j)
@@ -177,10 +177,10 @@ wc_status wc_world_add_grid_cloth(wc_world *w, const wc_grid_cloth_def *d, int32
             f[3] = (j + 1) * nu + i;
         }
     wc_cloth *c;
-    s = wc_cloth_create(&c, xyz, n, faces, quads, 4, &d->material, d->self_collision, d->wetness,
+    s = wci_cloth_create(&c, xyz, n, faces, quads, 4, &d->material, d->self_collision, d->wetness,
                         &w->error);
-    wc_free(xyz);
-    wc_free(faces);
+    wci_free(xyz);
+    wci_free(faces);
     if (s) return s;
     c->collide_cloths = d->collide_with_cloths;
     return append_cloth(w, c, out_cloth);
@@ -191,14 +191,14 @@ static wc_cloth *cloth_with_count(const wc_world *w, int32_t cloth, const void *
                                   int32_t count, int32_t expected, const char *caller)
 {
     if (!w) return NULL;
-    wc_cloth *c = wc_world_find_cloth(w, cloth, caller);
+    wc_cloth *c = wci_world_find_cloth(w, cloth, caller);
     if (!c) return NULL;
     if (!array) {
-        wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT, "%s: the array is NULL", caller);
+        wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT, "%s: the array is NULL", caller);
         return NULL;
     }
     if (expected >= 0 && count != expected) {
-        wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+        wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT,
                 "%s: count must be %d for cloth %d but is %d", caller, (int)expected, (int)cloth,
                 (int)count);
         return NULL;
@@ -235,15 +235,15 @@ wc_status wc_cloth_get_links(const wc_world *w, int32_t cloth, wc_link_kind kind
                              int32_t *out_pairs, double *out_rest_lengths, int32_t capacity)
 {
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
-    wc_cloth *c = wc_world_find_cloth(w, cloth, "wc_cloth_get_links");
+    wc_cloth *c = wci_world_find_cloth(w, cloth, "wc_cloth_get_links");
     if (!c) return WC_ERROR_NOT_FOUND;
     const wc_link_set *s = link_set(c, kind);
     if (!s)
-        return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT,
                        "wc_cloth_get_links: kind must be WC_LINK_STRETCH (0) or WC_LINK_BEND (1) "
                        "but is %d", (int)kind);
     if (capacity < s->count)
-        return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT,
                        "wc_cloth_get_links: capacity must be at least %d but is %d", (int)s->count,
                        (int)capacity);
     for (int32_t e = 0; e < s->count; ++e) {
@@ -263,7 +263,7 @@ wc_status wc_cloth_get_triangles(const wc_world *w, int32_t cloth, int32_t *out,
     wc_cloth *c = cloth_with_count(w, cloth, out, capacity, -1, "wc_cloth_get_triangles");
     if (!c) return lookup_status(w, cloth);
     if (capacity < c->topology.triangle_count)
-        return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT,
                        "wc_cloth_get_triangles: capacity must be at least %d but is %d",
                        (int)c->topology.triangle_count, (int)capacity);
     memcpy(out, c->topology.triangles, 3 * (size_t)c->topology.triangle_count * sizeof *out);
@@ -299,9 +299,9 @@ wc_status wc_cloth_get_positions_f32(const wc_world *w, int32_t cloth, float *ou
 static wc_status check_finite_xyz(const wc_world *w, const double *xyz, int32_t count,
                                   const char *caller)
 {
-    long bad = wc_first_non_finite(xyz, 3L * count);
+    long bad = wci_first_non_finite(xyz, 3L * count);
     if (bad < 0) return WC_OK;
-    return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+    return wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT,
                    "%s: value %ld (%c of entry %ld) must be finite but is %g", caller, bad,
                    "xyz"[bad % 3], bad / 3, xyz[bad]);
 }
@@ -335,7 +335,7 @@ wc_status wc_cloth_get_velocities(const wc_world *w, int32_t cloth, double *out,
     wc_cloth *c = cloth_with_count(w, cloth, out, count, wc_cloth_particle_count(w, cloth),
                                    "wc_cloth_get_velocities");
     if (!c) return lookup_status(w, cloth);
-    for (int32_t i = 0; i < count; ++i) wc_cloth_velocity(c, i, out + 3 * (size_t)i);
+    for (int32_t i = 0; i < count; ++i) wci_cloth_velocity(c, i, out + 3 * (size_t)i);
     return WC_OK;
 }
 
@@ -383,23 +383,23 @@ wc_status wc_cloth_get_view(const wc_world *w, int32_t cloth, wc_cloth_view *out
 static wc_status validate_pins(const wc_world *w, wc_cloth *c, const int32_t *idx, int32_t count,
                                const char *caller)
 {
-    wc_message *msg = wc_world_message(w);
+    wc_message *msg = wci_world_message(w);
     if (count < 0 || (int64_t)count + c->pins.count > c->particle_count)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "%s: count must be in [0, %d] (unpinned particles) but is %d", caller,
                        (int)(c->particle_count - c->pins.count), (int)count);
     for (int32_t k = 0; k < count; ++k) {
         int32_t i = idx[k];
         if (i < 0 || i >= c->particle_count)
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "%s: indices[%d] is %d, but the cloth has %d particles", caller,
                            (int)k, (int)i, (int)c->particle_count);
         if (c->soft_pin_slot && c->soft_pin_slot[i] >= 0)
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "%s: indices[%d] = %d is already pinned (soft pin %d)", caller, (int)k,
                            (int)i, (int)c->soft_pin_slot[i]);
         if (c->pin_slot[i] >= 0)
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s: indices[%d] = %d is %s", caller,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s: indices[%d] = %d is %s", caller,
                            (int)k, (int)i,
                            c->pin_slot[i] < c->pins.count ? "already pinned"
                                                           : "repeated in the list");
@@ -421,7 +421,7 @@ static wc_status validate_stiffness(const wc_world *w, const int32_t *idx, const
 {
     for (int32_t k = 0; k < count; ++k)
         if (!(stiffness[k] > 0.0 && stiffness[k] <= MAX_PIN_STIFFNESS))
-            return wc_fail(wc_world_message(w), WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(wci_world_message(w), WC_ERROR_INVALID_ARGUMENT,
                            "wc_cloth_pin_soft: stiffness[%d] (for particle %d) must be in "
                            "(0, %g] 1/s^2 but is %g",
                            (int)k, (int)idx[k], MAX_PIN_STIFFNESS, stiffness[k]);
@@ -437,27 +437,27 @@ typedef struct grown_pins {
 
 static void free_grown(grown_pins *g)
 {
-    wc_free(g->particle);
-    wc_free(g->from);
-    wc_free(g->to);
-    wc_free(g->stiffness);
-    wc_free(g->soft_pin_slot);
+    wci_free(g->particle);
+    wci_free(g->from);
+    wci_free(g->to);
+    wci_free(g->stiffness);
+    wci_free(g->soft_pin_slot);
 }
 
 static int allocate_grown(const wc_cloth *c, int32_t total, int soft, grown_pins *g)
 {
     memset(g, 0, sizeof *g);
-    g->particle = wc_alloc_array((size_t)total, sizeof *g->particle);
-    g->from = wc_alloc_array(3 * (size_t)total, sizeof *g->from);
-    g->to = wc_alloc_array(3 * (size_t)total, sizeof *g->to);
+    g->particle = wci_alloc_array((size_t)total, sizeof *g->particle);
+    g->from = wci_alloc_array(3 * (size_t)total, sizeof *g->from);
+    g->to = wci_alloc_array(3 * (size_t)total, sizeof *g->to);
     int ok = g->particle && g->from && g->to;
     /* a cloth that ever had a soft pin keeps a stiffness per pin */
     if (soft || c->pins.stiffness) {
-        g->stiffness = wc_alloc_array((size_t)total, sizeof *g->stiffness);
+        g->stiffness = wci_alloc_array((size_t)total, sizeof *g->stiffness);
         ok &= g->stiffness != NULL;
     }
     if (soft && !c->soft_pin_slot) {
-        g->soft_pin_slot = wc_alloc_array((size_t)c->particle_count, sizeof *g->soft_pin_slot);
+        g->soft_pin_slot = wci_alloc_array((size_t)c->particle_count, sizeof *g->soft_pin_slot);
         ok &= g->soft_pin_slot != NULL;
     }
     if (!ok) free_grown(g);
@@ -494,10 +494,10 @@ static void install_pins(wc_cloth *c, grown_pins *g, const int32_t *idx, const d
         else
             c->pin_slot[i] = p;
     }
-    wc_free(c->pins.particle);
-    wc_free(c->pins.from);
-    wc_free(c->pins.to);
-    if (g->stiffness) wc_free(c->pins.stiffness);
+    wci_free(c->pins.particle);
+    wci_free(c->pins.from);
+    wci_free(c->pins.to);
+    if (g->stiffness) wci_free(c->pins.stiffness);
     c->pins.particle = g->particle;
     c->pins.from = g->from;
     c->pins.to = g->to;
@@ -513,19 +513,19 @@ static wc_status add_pins(wc_world *w, int32_t cloth, const int32_t *idx, int so
     wc_cloth *c = cloth_with_count(w, cloth, idx, count, -1, caller);
     if (!c) return lookup_status(w, cloth);
     if (soft && !stiffness)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "%s: the stiffness array is NULL",
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "%s: the stiffness array is NULL",
                        caller);
     wc_status s = validate_pins(w, c, idx, count, caller);
     if (!s && soft) s = validate_stiffness(w, idx, stiffness, count);
     grown_pins g;
     if (!s && !allocate_grown(c, c->pins.count + count, soft, &g))
-        s = wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory pinning %d particles",
+        s = wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory pinning %d particles",
                     (int)count);
     undo_pin_marks(c, idx, count);
     if (s) return s;
     install_pins(c, &g, idx, soft ? stiffness : NULL, count);
     /* the springs are explicit forces for Verlet and XPBD */
-    if (soft) wc_cloth_update_stable_dt(c);
+    if (soft) wci_cloth_update_stable_dt(c);
     return WC_OK;
 }
 
@@ -543,7 +543,7 @@ wc_status wc_cloth_pin_soft(wc_world *w, int32_t cloth, const int32_t *idx, cons
 wc_status wc_cloth_unpin_all(wc_world *w, int32_t cloth)
 {
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
-    wc_cloth *c = wc_world_find_cloth(w, cloth, "wc_cloth_unpin_all");
+    wc_cloth *c = wci_world_find_cloth(w, cloth, "wc_cloth_unpin_all");
     if (!c) return WC_ERROR_NOT_FOUND;
     for (int32_t p = 0; p < c->pins.count; ++p) {
         int32_t i = c->pins.particle[p];
@@ -553,7 +553,7 @@ wc_status wc_cloth_unpin_all(wc_world *w, int32_t cloth)
     int had_soft = c->pins.soft_count > 0;
     c->pins.count = 0;
     c->pins.soft_count = 0;
-    if (had_soft) wc_cloth_update_stable_dt(c);
+    if (had_soft) wci_cloth_update_stable_dt(c);
     return WC_OK;
 }
 
@@ -587,7 +587,7 @@ wc_status wc_cloth_get_energy(const wc_world *w, int32_t cloth, wc_energy *out)
     wc_energy e = {0.0, 0.0, 0.0, 0.0};
     for (int32_t i = 0; i < c->particle_count; ++i) {
         double v[3];
-        wc_cloth_velocity(c, i, v);
+        wci_cloth_velocity(c, i, v);
         e.kinetic += 0.5 * c->mass[i] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         e.gravity -= c->mass[i] * (g[0] * c->x[i] + g[1] * c->y[i] + g[2] * c->z[i]);
     }
@@ -604,7 +604,7 @@ wc_status wc_cloth_get_energy(const wc_world *w, int32_t cloth, wc_energy *out)
         double d = sqrt((c->x[a] - c->x[b]) * (c->x[a] - c->x[b]) +
                         (c->y[a] - c->y[b]) * (c->y[a] - c->y[b]) +
                         (c->z[a] - c->z[b]) * (c->z[a] - c->z[b]));
-        e.bend += wc_buckling_energy_ramped(d, t->bend.rest[k], c->bend_r[k]);
+        e.bend += wci_buckling_energy_ramped(d, t->bend.rest[k], c->bend_r[k]);
     }
     *out = e;
     return WC_OK;
@@ -635,13 +635,13 @@ wc_status wc_cloth_get_contacts(const wc_world *w, int32_t cloth, uint8_t *out_k
 wc_status wc_cloth_set_wetness_uniform(wc_world *w, int32_t cloth, double wetness)
 {
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
-    wc_cloth *c = wc_world_find_cloth(w, cloth, "wc_cloth_set_wetness_uniform");
+    wc_cloth *c = wci_world_find_cloth(w, cloth, "wc_cloth_set_wetness_uniform");
     if (!c) return WC_ERROR_NOT_FOUND;
     if (!(wetness >= 0.0 && wetness <= 1.0))
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "wc_cloth_set_wetness_uniform: wetness must be in [0, 1] but is %g", wetness);
     for (int32_t i = 0; i < c->particle_count; ++i) c->wetness[i] = wetness;
-    wc_cloth_apply_material(c);
+    wci_cloth_apply_material(c);
     return WC_OK;
 }
 
@@ -652,11 +652,11 @@ wc_status wc_cloth_set_wetness(wc_world *w, int32_t cloth, const double *wetness
     if (!c) return lookup_status(w, cloth);
     for (int32_t i = 0; i < count; ++i)
         if (!(wetness[i] >= 0.0 && wetness[i] <= 1.0))
-            return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                            "wc_cloth_set_wetness: wetness[%d] must be in [0, 1] but is %g", (int)i,
                            wetness[i]);
     memcpy(c->wetness, wetness, (size_t)count * sizeof *wetness);
-    wc_cloth_apply_material(c);
+    wci_cloth_apply_material(c);
     return WC_OK;
 }
 

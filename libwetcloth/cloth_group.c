@@ -30,8 +30,8 @@ struct wc_cloth_group {
     /// Its adhesive pairs are the wet pairs between different members
     /// (wetness.c), in combined numbering.
     wc_cloth combined;
-    /// Those pairs as wc_cloth_group_save found them, for
-    /// wc_cloth_group_restore.
+    /// Those pairs as wci_cloth_group_save found them, for
+    /// wci_cloth_group_restore.
     int32_t *saved_pairs;
     double *saved_data;
     int64_t saved_count, saved_capacity;
@@ -53,14 +53,14 @@ static void byte_fields(wc_cloth *c, uint8_t **out[BYTE_FIELDS])
     memcpy(out, f, sizeof f);
 }
 
-int wc_cloth_group_possible(wc_cloth *const *cloths, int32_t cloth_count)
+int wci_cloth_group_possible(wc_cloth *const *cloths, int32_t cloth_count)
 {
     int32_t members = 0;
     for (int32_t c = 0; c < cloth_count; ++c) members += cloths[c]->collide_cloths != 0;
     return members >= 2;
 }
 
-void wc_cloth_group_destroy(wc_cloth_group *g)
+void wci_cloth_group_destroy(wc_cloth_group *g)
 {
     if (!g) return;
     wc_cloth *c = &g->combined;
@@ -68,18 +68,18 @@ void wc_cloth_group_destroy(wc_cloth_group *g)
     uint8_t **b[BYTE_FIELDS];
     double_fields(c, d);
     byte_fields(c, b);
-    for (int k = 0; k < DOUBLE_FIELDS; ++k) wc_free(*d[k]);
-    for (int k = 0; k < BYTE_FIELDS; ++k) wc_free(*b[k]);
-    wc_free(c->pin_slot);
-    wc_free(c->topology.triangles);
-    wc_free(c->self_touched);
-    wc_free(c->adhesive_pairs);
-    wc_free(c->adhesive_data);
-    wc_self_state_destroy(c->self);
+    for (int k = 0; k < DOUBLE_FIELDS; ++k) wci_free(*d[k]);
+    for (int k = 0; k < BYTE_FIELDS; ++k) wci_free(*b[k]);
+    wci_free(c->pin_slot);
+    wci_free(c->topology.triangles);
+    wci_free(c->self_touched);
+    wci_free(c->adhesive_pairs);
+    wci_free(c->adhesive_data);
+    wci_self_state_destroy(c->self);
     void *blocks[] = {g->member, g->first, g->first_triangle, g->self, g->friction,
                       g->wet_friction, g->handled, g->saved_pairs, g->saved_data, g->pieces};
-    for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
-    wc_free(g);
+    for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wci_free(blocks[k]);
+    wci_free(g);
 }
 
 /* Members, offsets and the combined cloth's arrays; 0 on out-of-memory. */
@@ -89,14 +89,14 @@ static int allocate(wc_cloth_group *g, wc_cloth *const *cloths, int32_t cloth_co
     for (int32_t c = 0; c < cloth_count; ++c) m += cloths[c]->collide_cloths != 0;
     g->count = m;
     g->world_cloths = cloth_count;
-    g->member = wc_alloc_array((size_t)m, sizeof *g->member);
-    g->first = wc_alloc_array((size_t)m + 1, sizeof *g->first);
-    g->first_triangle = wc_alloc_array((size_t)m + 1, sizeof *g->first_triangle);
-    g->self = wc_alloc_array((size_t)m, 1);
-    g->friction = wc_alloc_array((size_t)m, sizeof *g->friction);
-    g->wet_friction = wc_alloc_array((size_t)m, sizeof *g->wet_friction);
-    g->handled = wc_alloc_array((size_t)cloth_count, 1);
-    g->pieces = wc_alloc_array((size_t)m, sizeof *g->pieces);
+    g->member = wci_alloc_array((size_t)m, sizeof *g->member);
+    g->first = wci_alloc_array((size_t)m + 1, sizeof *g->first);
+    g->first_triangle = wci_alloc_array((size_t)m + 1, sizeof *g->first_triangle);
+    g->self = wci_alloc_array((size_t)m, 1);
+    g->friction = wci_alloc_array((size_t)m, sizeof *g->friction);
+    g->wet_friction = wci_alloc_array((size_t)m, sizeof *g->wet_friction);
+    g->handled = wci_alloc_array((size_t)cloth_count, 1);
+    g->pieces = wci_alloc_array((size_t)m, sizeof *g->pieces);
     if (!g->member || !g->first || !g->first_triangle || !g->self || !g->friction ||
         !g->wet_friction || !g->handled || !g->pieces)
         return 0;
@@ -118,11 +118,11 @@ static int allocate(wc_cloth_group *g, wc_cloth *const *cloths, int32_t cloth_co
     double_fields(comb, d);
     byte_fields(comb, b);
     int ok = 1;
-    for (int k = 0; k < DOUBLE_FIELDS; ++k) ok &= (*d[k] = wc_alloc_array(n, sizeof(double))) != NULL;
-    for (int k = 0; k < BYTE_FIELDS; ++k) ok &= (*b[k] = wc_alloc_array(n, 1)) != NULL;
-    comb->pin_slot = wc_alloc_array(n, sizeof *comb->pin_slot);
+    for (int k = 0; k < DOUBLE_FIELDS; ++k) ok &= (*d[k] = wci_alloc_array(n, sizeof(double))) != NULL;
+    for (int k = 0; k < BYTE_FIELDS; ++k) ok &= (*b[k] = wci_alloc_array(n, 1)) != NULL;
+    comb->pin_slot = wci_alloc_array(n, sizeof *comb->pin_slot);
     comb->topology.triangles =
-        wc_alloc_array(3 * (size_t)g->first_triangle[m], sizeof *comb->topology.triangles);
+        wci_alloc_array(3 * (size_t)g->first_triangle[m], sizeof *comb->topology.triangles);
     return ok && comb->pin_slot && comb->topology.triangles;
 }
 
@@ -138,7 +138,7 @@ static int build_combined(wc_cloth_group *g, wc_cloth *const *cloths)
         const int32_t *tri = cl->topology.triangles;
         int32_t *out = comb->topology.triangles + 3 * (size_t)g->first_triangle[k];
         for (size_t t = 0; t < 3 * (size_t)cl->topology.triangle_count; ++t) out[t] = tri[t] + off;
-        const double *rest = cl->self ? wc_self_state_rest(cl->self) : NULL;
+        const double *rest = cl->self ? wci_self_state_rest(cl->self) : NULL;
         for (int32_t i = 0; i < n; ++i) {
             comb->x[off + i] = rest ? rest[3 * (size_t)i] : cl->x[i];
             comb->y[off + i] = rest ? rest[3 * (size_t)i + 1] : cl->y[i];
@@ -148,25 +148,25 @@ static int build_combined(wc_cloth_group *g, wc_cloth *const *cloths)
         g->wet_friction[k] = cl->material.wet_friction;
     }
     wc_self_pieces pieces = {g->count, g->first, g->self, g->friction, g->wet_friction};
-    comb->self = wc_self_state_create_pieces(comb, &pieces);
+    comb->self = wci_self_state_create_pieces(comb, &pieces);
     return comb->self != NULL;
 }
 
-int wc_cloth_group_sync(wc_cloth_group **group, wc_cloth *const *cloths, int32_t cloth_count)
+int wci_cloth_group_update(wc_cloth_group **group, wc_cloth *const *cloths, int32_t cloth_count)
 {
     if (*group && (*group)->world_cloths == cloth_count) return 0;
-    if (!wc_cloth_group_possible(cloths, cloth_count)) {
-        wc_cloth_group_destroy(*group);
+    if (!wci_cloth_group_possible(cloths, cloth_count)) {
+        wci_cloth_group_destroy(*group);
         *group = NULL;
         return 0;
     }
-    wc_cloth_group *g = wc_alloc_array(1, sizeof *g);
+    wc_cloth_group *g = wci_alloc_array(1, sizeof *g);
     if (!g) return 1;
     if (!allocate(g, cloths, cloth_count) || !build_combined(g, cloths)) {
-        wc_cloth_group_destroy(g);
+        wci_cloth_group_destroy(g);
         return 1;
     }
-    wc_cloth_group_destroy(*group);
+    wci_cloth_group_destroy(*group);
     *group = g;
     return 0;
 }
@@ -190,7 +190,7 @@ static int members_meet(const wc_cloth_group *g, wc_cloth *const *cloths, double
 {
     enum { STACK = 16 };
     double stack[6 * STACK], *boxes = stack;
-    if (g->count > STACK) boxes = wc_alloc_array(6 * (size_t)g->count, sizeof *boxes);
+    if (g->count > STACK) boxes = wci_alloc_array(6 * (size_t)g->count, sizeof *boxes);
     if (!boxes) return 1; /* cannot tell: run the combined pass, which is always right */
     for (int32_t k = 0; k < g->count; ++k) motion_box(cloths[g->member[k]], boxes + 6 * k);
     int meet = 0;
@@ -200,7 +200,7 @@ static int members_meet(const wc_cloth_group *g, wc_cloth *const *cloths, double
             meet = p[0] - h <= q[3] && q[0] <= p[3] + h && p[1] - h <= q[4] && q[1] <= p[4] + h &&
                    p[2] - h <= q[5] && q[2] <= p[5] + h;
         }
-    if (boxes != stack) wc_free(boxes);
+    if (boxes != stack) wci_free(boxes);
     return meet;
 }
 
@@ -241,9 +241,9 @@ static int32_t member_of(const wc_cloth_group *g, int32_t i)
 /* Self-adhesion: the vertex-face pairs the combined pass answered within
  * one wet self-colliding member go to that member, which keeps its
  * adhesive pairs as it would alone. Those between two members stay with
- * the combined cloth, which keeps them the same way (wc_wet_self_pairs: the
+ * the combined cloth, which keeps them the same way (wci_wet_self_pairs: the
  * answered ones and last step's still within the hold band), so that wet
- * cloths stick to each other (wc_cloth_group_adhesion). */
+ * cloths stick to each other (wci_cloth_group_adhesion). */
 static wc_status hand_out_adhesion(wc_cloth_group *g, wc_cloth *const *cloths, double h)
 {
     wc_cloth *comb = &g->combined;
@@ -257,31 +257,31 @@ static wc_status hand_out_adhesion(wc_cloth_group *g, wc_cloth *const *cloths, d
             comb->self_touched[2 * across] = v, comb->self_touched[2 * across + 1] = t;
             ++across;
         } else if (cl->self && cl->wet_forces) {
-            wc_wet_note_self_contact(cl, v - g->first[k], t - g->first_triangle[k]);
+            wci_wet_note_self_contact(cl, v - g->first[k], t - g->first_triangle[k]);
         }
     }
     comb->self_touched_count = failed ? 0 : across, comb->self_touched_failed = 0;
     if (failed) return WC_ERROR_OUT_OF_MEMORY;
     for (int32_t k = 0; k < g->count; ++k) {
         wc_cloth *cl = cloths[g->member[k]];
-        if (cl->self && cl->wet_forces && wc_wet_self_pairs(cl, h)) return WC_ERROR_OUT_OF_MEMORY;
+        if (cl->self && cl->wet_forces && wci_wet_self_pairs(cl, h)) return WC_ERROR_OUT_OF_MEMORY;
     }
-    return wc_wet_self_pairs(comb, h);
+    return wci_wet_self_pairs(comb, h);
 }
 
-int wc_cloth_group_save(wc_cloth_group *g)
+int wci_cloth_group_save(wc_cloth_group *g)
 {
     if (!g) return 0;
     const wc_cloth *comb = &g->combined;
     int64_t n = comb->adhesive_count;
     if (n > g->saved_capacity) {
-        int32_t *pairs = wc_alloc_array((size_t)n, 2 * sizeof *pairs);
-        double *data = wc_alloc_array((size_t)n, 6 * sizeof *data);
+        int32_t *pairs = wci_alloc_array((size_t)n, 2 * sizeof *pairs);
+        double *data = wci_alloc_array((size_t)n, 6 * sizeof *data);
         if (!pairs || !data) {
-            wc_free(pairs), wc_free(data);
+            wci_free(pairs), wci_free(data);
             return 1;
         }
-        wc_free(g->saved_pairs), wc_free(g->saved_data);
+        wci_free(g->saved_pairs), wci_free(g->saved_data);
         g->saved_pairs = pairs, g->saved_data = data, g->saved_capacity = n;
     }
     if (n) {
@@ -292,7 +292,7 @@ int wc_cloth_group_save(wc_cloth_group *g)
     return 0;
 }
 
-void wc_cloth_group_restore(wc_cloth_group *g)
+void wci_cloth_group_restore(wc_cloth_group *g)
 {
     if (!g) return;
     wc_cloth *comb = &g->combined;
@@ -305,7 +305,7 @@ void wc_cloth_group_restore(wc_cloth_group *g)
     comb->self_touched_count = 0, comb->self_touched_failed = 0;
 }
 
-void wc_cloth_group_adhesion(wc_cloth_group *g, wc_cloth *const *cloths)
+void wci_cloth_group_adhesion(wc_cloth_group *g, wc_cloth *const *cloths)
 {
     if (!g || g->combined.adhesive_count == 0) return;
     for (int32_t k = 0; k < g->count; ++k) {
@@ -315,11 +315,11 @@ void wc_cloth_group_adhesion(wc_cloth_group *g, wc_cloth *const *cloths)
         g->pieces[k] = piece;
     }
     const wc_cloth *comb = &g->combined;
-    wc_wet_pair_adhesion(comb->adhesive_pairs, comb->adhesive_data, comb->adhesive_count,
+    wci_wet_pair_adhesion(comb->adhesive_pairs, comb->adhesive_data, comb->adhesive_count,
                          comb->topology.triangles, g->pieces, g->count);
 }
 
-wc_status wc_cloth_group_collide(wc_cloth_group *g, wc_cloth *const *cloths, double dt,
+wc_status wci_cloth_group_collide(wc_cloth_group *g, wc_cloth *const *cloths, double dt,
                                  int threads, wc_step_stats *stats)
 {
     wc_cloth *comb = &g->combined;
@@ -334,30 +334,30 @@ wc_status wc_cloth_group_collide(wc_cloth_group *g, wc_cloth *const *cloths, dou
         g->friction[k] = cl->material.friction;
         g->wet_friction[k] = cl->material.wet_friction;
     }
-    double h = wc_self_thickness(comb);
+    double h = wci_self_thickness(comb);
     /* pairs between dry members do not pull; adhering ones hold within the
      * band, so while there are any the pass runs within the band too */
     if (!comb->wet_forces) comb->adhesive_count = 0;
     if (!members_meet(g, cloths, comb->adhesive_count ? (1.0 + WC_WET_HOLD_BAND) * h : h)) {
         /* the candidates were made for motions of an earlier step */
-        wc_self_state_invalidate(comb->self);
+        wci_self_state_invalidate(comb->self);
         comb->adhesive_count = 0;
         return WC_OK;
     }
-    wc_self_state_set_friction(comb->self, g->friction, g->wet_friction);
+    wci_self_state_set_friction(comb->self, g->friction, g->wet_friction);
     copy_state(g, cloths, 0);
-    if (wc_self_collide(comb, dt, threads, stats)) return WC_ERROR_OUT_OF_MEMORY;
+    if (wci_self_collide(comb, dt, threads, stats)) return WC_ERROR_OUT_OF_MEMORY;
     copy_state(g, cloths, 1);
     for (int32_t k = 0; k < g->count; ++k) {
         wc_cloth *cl = cloths[g->member[k]];
         g->handled[g->member[k]] = 1;
         /* its own candidates will be out of date when it next runs alone */
-        if (cl->self) wc_self_state_invalidate(cl->self);
+        if (cl->self) wci_self_state_invalidate(cl->self);
     }
     return comb->wet_forces ? hand_out_adhesion(g, cloths, h) : WC_OK;
 }
 
-int wc_cloth_group_handled(const wc_cloth_group *g, int32_t cloth)
+int wci_cloth_group_handled(const wc_cloth_group *g, int32_t cloth)
 {
     return g && cloth < g->world_cloths && g->handled[cloth];
 }

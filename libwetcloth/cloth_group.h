@@ -23,9 +23,9 @@ typedef struct wc_cloth_group wc_cloth_group;
 /// cloths with collide_cloths set, in world order; a group needs two).
 /// Cheap when nothing changed. Non-zero on out-of-memory, with *group as it
 /// was.
-int wc_cloth_group_sync(wc_cloth_group **group, wc_cloth *const *cloths, int32_t cloth_count);
+int wci_cloth_group_update(wc_cloth_group **group, wc_cloth *const *cloths, int32_t cloth_count);
 
-void wc_cloth_group_destroy(wc_cloth_group *group);
+void wci_cloth_group_destroy(wc_cloth_group *group);
 
 /// After every cloth's collider passes: when two members' motions x -> nx
 /// come within the group's thickness, resolves the collisions of all
@@ -35,33 +35,33 @@ void wc_cloth_group_destroy(wc_cloth_group *group);
 /// them handled; otherwise marks none.
 /// Deterministic for any thread count. WC_ERROR_OUT_OF_MEMORY on
 /// out-of-memory (the caller restores the contact state).
-wc_status wc_cloth_group_collide(wc_cloth_group *group, wc_cloth *const *cloths, double dt,
+wc_status wci_cloth_group_collide(wc_cloth_group *group, wc_cloth *const *cloths, double dt,
                                  int threads, wc_step_stats *stats);
 
 /// Before a step's collisions, with the members' contact state
 /// (contact_backup.h): keeps the wet pairs between members for
-/// wc_cloth_group_restore. Non-zero on out-of-memory, nothing changed.
+/// wci_cloth_group_restore. Non-zero on out-of-memory, nothing changed.
 /// Nothing to copy without such pairs. NULL is a no-op.
-int wc_cloth_group_save(wc_cloth_group *group);
+int wci_cloth_group_save(wc_cloth_group *group);
 
 /// After the collisions of a step failed: the wet pairs between members as
-/// wc_cloth_group_save found them (the members' own state is put back by
+/// wci_cloth_group_save found them (the members' own state is put back by
 /// contact_backup.h). NULL is a no-op.
-void wc_cloth_group_restore(wc_cloth_group *group);
+void wci_cloth_group_restore(wc_cloth_group *group);
 
 /// Adds the wet adhesion between members (the pairs the last collision
 /// kept, wetness.c's self-adhesion law across cloths) to their fx, fy, fz:
 /// equal and opposite, serial in pair order, so the sums do not depend on
 /// the thread count. Nothing to do, and no cost, without such pairs (no
 /// member wet, or none touching another). NULL is a no-op.
-void wc_cloth_group_adhesion(wc_cloth_group *group, wc_cloth *const *cloths);
+void wci_cloth_group_adhesion(wc_cloth_group *group, wc_cloth *const *cloths);
 
-/// Whether the last wc_cloth_group_collide resolved cloth `cloth` (a world
+/// Whether the last wci_cloth_group_collide resolved cloth `cloth` (a world
 /// index): then its own self-collision must not run in that step.
-int wc_cloth_group_handled(const wc_cloth_group *group, int32_t cloth);
+int wci_cloth_group_handled(const wc_cloth_group *group, int32_t cloth);
 
 /// Whether the cloths can collide with each other at all: two or more with
 /// collide_cloths set.
-int wc_cloth_group_possible(wc_cloth *const *cloths, int32_t cloth_count);
+int wci_cloth_group_possible(wc_cloth *const *cloths, int32_t cloth_count);
 
 #endif

@@ -36,20 +36,20 @@ wc_convex_collider_def wc_convex_collider_def_default(void)
     return d;
 }
 
-void wc_collider_destroy(wc_collider *c)
+void wci_collider_destroy(wc_collider *c)
 {
     if (!c) return;
-    wc_free(c->triangles);
-    wc_free(c->edges);
-    wc_free(c->triangle_edges);
-    wc_free(c->current);
-    wc_free(c->target);
-    wc_free(c->next);
-    wc_free(c->boxes);
-    wc_free(c->normals);
-    wc_bvh_free(&c->bvh);
-    wc_convex_shape_free(&c->convex);
-    wc_free(c);
+    wci_free(c->triangles);
+    wci_free(c->edges);
+    wci_free(c->triangle_edges);
+    wci_free(c->current);
+    wci_free(c->target);
+    wci_free(c->next);
+    wci_free(c->boxes);
+    wci_free(c->normals);
+    wci_bvh_destroy(&c->bvh);
+    wci_convex_shape_destroy(&c->convex);
+    wci_free(c);
 }
 
 static int compare_triples(const void *pa, const void *pb)
@@ -66,11 +66,11 @@ static int compare_triples(const void *pa, const void *pb)
 static int build_edges(wc_collider *c)
 {
     size_t n = 3 * (size_t)c->triangle_count;
-    int32_t *entries = wc_alloc_array(3 * n, sizeof *entries);
-    c->edges = wc_alloc_array(2 * n, sizeof *c->edges);
-    c->triangle_edges = wc_alloc_array(n, sizeof *c->triangle_edges);
+    int32_t *entries = wci_alloc_array(3 * n, sizeof *entries);
+    c->edges = wci_alloc_array(2 * n, sizeof *c->edges);
+    c->triangle_edges = wci_alloc_array(n, sizeof *c->triangle_edges);
     if (!entries || !c->edges || !c->triangle_edges) {
-        wc_free(entries);
+        wci_free(entries);
         return 0;
     }
     for (size_t t = 0; t < (size_t)c->triangle_count; ++t)
@@ -95,7 +95,7 @@ static int build_edges(wc_collider *c)
         c->triangle_edges[e[2]] = unique - 1;
     }
     c->edge_count = unique;
-    wc_free(entries);
+    wci_free(entries);
     return 1;
 }
 
@@ -103,14 +103,14 @@ static wc_status append_collider(wc_world *w, wc_collider *c, int32_t *out)
 {
     if (w->collider_count == w->collider_capacity) {
         int32_t capacity = w->collider_capacity ? 2 * w->collider_capacity : 4;
-        wc_collider **grown = wc_alloc_array((size_t)capacity, sizeof *grown);
+        wc_collider **grown = wci_alloc_array((size_t)capacity, sizeof *grown);
         if (!grown) {
-            wc_collider_destroy(c);
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
+            wci_collider_destroy(c);
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
         }
         if (w->collider_count)
             memcpy(grown, w->colliders, (size_t)w->collider_count * sizeof *grown);
-        wc_free(w->colliders);
+        wci_free(w->colliders);
         w->colliders = grown;
         w->collider_capacity = capacity;
     }
@@ -122,10 +122,10 @@ static wc_status append_collider(wc_world *w, wc_collider *c, int32_t *out)
 static wc_status check_surface(wc_message *msg, const char *def, double thickness, double friction)
 {
     if (!(isfinite(thickness) && thickness >= 0.0 && thickness <= 1.0))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s.thickness must be in [0, 1] m but is %g",
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s.thickness must be in [0, 1] m but is %g",
                        def, thickness);
     if (!(isfinite(friction) && friction >= 0.0 && friction <= 10.0))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s.friction must be in [0, 10] but is %g",
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "%s.friction must be in [0, 10] but is %g",
                        def, friction);
     return WC_OK;
 }
@@ -133,24 +133,24 @@ static wc_status check_surface(wc_message *msg, const char *def, double thicknes
 static wc_status validate_mesh(const wc_mesh_collider_def *d, wc_message *msg)
 {
     if (d->vertex_count < 3 || d->vertex_count > MAX_VERTICES)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_collider_def.vertex_count must be in [3, %d] but is %d", MAX_VERTICES,
                        (int)d->vertex_count);
     if (d->triangle_count < 1 || d->triangle_count > MAX_TRIANGLES)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_collider_def.triangle_count must be in [1, %d] but is %d",
                        MAX_TRIANGLES, (int)d->triangle_count);
     if (!d->vertices || !d->triangles)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "mesh_collider_def.%s is NULL",
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "mesh_collider_def.%s is NULL",
                        d->vertices ? "triangles" : "vertices");
-    long bad = wc_first_non_finite(d->vertices, 3L * d->vertex_count);
+    long bad = wci_first_non_finite(d->vertices, 3L * d->vertex_count);
     if (bad >= 0)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "mesh_collider_def.vertices: vertex %ld has a non-finite %c (%g)", bad / 3,
                        "xyz"[bad % 3], d->vertices[bad]);
     for (int64_t k = 0; k < 3 * (int64_t)d->triangle_count; ++k)
         if (d->triangles[k] < 0 || d->triangles[k] >= d->vertex_count)
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "collider triangle %lld uses vertex %d, but the collider has %d vertices",
                            (long long)(k / 3), (int)d->triangles[k], (int)d->vertex_count);
     return check_surface(msg, "mesh_collider_def", d->thickness, d->friction);
@@ -160,11 +160,11 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
 {
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
     if (!d || !out)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_mesh_collider: %s is NULL",
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_world_add_mesh_collider: %s is NULL",
                        d ? "out_collider" : "def");
     wc_status s = validate_mesh(d, &w->error);
     if (s) return s;
-    wc_collider *c = wc_alloc_array(1, sizeof *c);
+    wc_collider *c = wci_alloc_array(1, sizeof *c);
     size_t nv = 3 * (size_t)d->vertex_count, nt = (size_t)d->triangle_count;
     if (c) {
         c->is_mesh = 1;
@@ -172,22 +172,22 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
         c->friction = d->friction;
         c->vertex_count = d->vertex_count;
         c->triangle_count = d->triangle_count;
-        wc_bvh_init(&c->bvh);
-        c->triangles = wc_alloc_array(3 * nt, sizeof *c->triangles);
-        c->current = wc_alloc_array(nv, sizeof *c->current);
-        c->target = wc_alloc_array(nv, sizeof *c->target);
-        c->next = wc_alloc_array(nv, sizeof *c->next);
-        c->boxes = wc_alloc_array(6 * nt, sizeof *c->boxes);
-        c->normals = wc_alloc_array(3 * nt, sizeof *c->normals);
+        memset(&c->bvh, 0, sizeof c->bvh);
+        c->triangles = wci_alloc_array(3 * nt, sizeof *c->triangles);
+        c->current = wci_alloc_array(nv, sizeof *c->current);
+        c->target = wci_alloc_array(nv, sizeof *c->target);
+        c->next = wci_alloc_array(nv, sizeof *c->next);
+        c->boxes = wci_alloc_array(6 * nt, sizeof *c->boxes);
+        c->normals = wci_alloc_array(3 * nt, sizeof *c->normals);
     }
     if (!c || !c->triangles || !c->current || !c->target || !c->next || !c->boxes || !c->normals) {
-        wc_collider_destroy(c);
-        return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
+        wci_collider_destroy(c);
+        return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
     }
     memcpy(c->triangles, d->triangles, 3 * nt * sizeof *c->triangles);
     if (!build_edges(c)) {
-        wc_collider_destroy(c);
-        return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
+        wci_collider_destroy(c);
+        return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
     }
     memcpy(c->current, d->vertices, nv * sizeof *c->current);
     memcpy(c->target, d->vertices, nv * sizeof *c->target);
@@ -199,14 +199,14 @@ wc_status wc_world_add_convex_collider(wc_world *w, const wc_convex_collider_def
 {
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
     if (!d || !out)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "wc_world_add_convex_collider: %s is NULL", d ? "out_collider" : "def");
-    wc_collider *c = wc_alloc_array(1, sizeof *c);
-    if (!c) return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
-    wc_bvh_init(&c->bvh);
-    wc_status s = wc_convex_shape_init(&c->convex, &c->pose_current, d, &w->error);
+    wc_collider *c = wci_alloc_array(1, sizeof *c);
+    if (!c) return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
+    memset(&c->bvh, 0, sizeof c->bvh);
+    wc_status s = wci_convex_shape_create(&c->convex, &c->pose_current, d, &w->error);
     if (s) {
-        wc_collider_destroy(c);
+        wci_collider_destroy(c);
         return s;
     }
     c->thickness = d->thickness;
@@ -218,7 +218,7 @@ wc_status wc_world_add_convex_collider(wc_world *w, const wc_convex_collider_def
 static wc_collider *find_collider(wc_world *w, int32_t collider, const char *caller)
 {
     if (collider >= 0 && collider < w->collider_count) return w->colliders[collider];
-    wc_fail(&w->error, WC_ERROR_NOT_FOUND, "%s: collider %d does not exist (the world has %d)",
+    wci_fail(&w->error, WC_ERROR_NOT_FOUND, "%s: collider %d does not exist (the world has %d)",
             caller, (int)collider, (int)w->collider_count);
     return NULL;
 }
@@ -229,17 +229,17 @@ wc_status wc_collider_set_vertices(wc_world *w, int32_t collider, const double *
     wc_collider *c = find_collider(w, collider, "wc_collider_set_vertices");
     if (!c) return WC_ERROR_NOT_FOUND;
     if (!c->is_mesh)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "wc_collider_set_vertices: collider %d is convex; use wc_collider_set_transform",
                        (int)collider);
     if (!xyz || count != c->vertex_count)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "wc_collider_set_vertices: %s for collider %d (it has %d vertices, count is %d)",
                        xyz ? "count mismatch" : "xyz is NULL", (int)collider, (int)c->vertex_count,
                        (int)count);
-    long bad = wc_first_non_finite(xyz, 3L * count);
+    long bad = wci_first_non_finite(xyz, 3L * count);
     if (bad >= 0)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "wc_collider_set_vertices: vertex %ld has a non-finite %c (%g)", bad / 3,
                        "xyz"[bad % 3], xyz[bad]);
     memcpy(c->target, xyz, 3 * (size_t)count * sizeof *xyz);
@@ -257,22 +257,22 @@ wc_status wc_collider_set_transform(wc_world *w, int32_t collider, const double 
     wc_collider *c = find_collider(w, collider, "wc_collider_set_transform");
     if (!c) return WC_ERROR_NOT_FOUND;
     if (c->is_mesh)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "wc_collider_set_transform: collider %d is a mesh; use wc_collider_set_vertices",
                        (int)collider);
     if (!position || !rotation)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_collider_set_transform: %s is NULL",
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "wc_collider_set_transform: %s is NULL",
                        position ? "rotation" : "position");
     double norm = 0.0;
     for (int k = 0; k < 4; ++k) norm += rotation[k] * rotation[k];
     norm = sqrt(norm);
     for (int k = 0; k < 3; ++k)
         if (!isfinite(position[k]))
-            return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                            "wc_collider_set_transform: position[%d] must be finite but is %g", k,
                            position[k]);
     if (!(isfinite(norm) && norm > 1e-12))
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "wc_collider_set_transform: rotation must be a finite non-zero quaternion "
                        "(w, x, y, z) but has norm %g", norm);
     for (int k = 0; k < 3; ++k) c->pose_target.position[k] = position[k];
@@ -310,7 +310,7 @@ static wc_status index_mesh(wc_collider *c)
         }
     }
     if (c->bvh.node_count == 0) {
-        if (wc_bvh_build(&c->bvh, c->boxes, c->triangle_count)) return WC_ERROR_OUT_OF_MEMORY;
+        if (wci_bvh_create(&c->bvh, c->boxes, c->triangle_count)) return WC_ERROR_OUT_OF_MEMORY;
         double total = 0.0;
         for (int32_t e = 0; e < c->edge_count; ++e) {
             const double *a = c->current + 3 * (size_t)c->edges[2 * (size_t)e];
@@ -320,7 +320,7 @@ static wc_status index_mesh(wc_collider *c)
         }
         c->feature_size = c->edge_count ? total / c->edge_count : 0.0;
     } else {
-        wc_bvh_refit(&c->bvh);
+        wci_bvh_refit(&c->bvh);
     }
     memcpy(c->bounds, c->bvh.nodes[0].box, sizeof c->bounds);
     c->indexed = 1;
@@ -331,7 +331,7 @@ static void static_normals(wc_collider *c)
 {
     for (int32_t t = 0; t < c->triangle_count; ++t) {
         const int32_t *v = c->triangles + 3 * (size_t)t;
-        wc_triangle_normal(c->current + 3 * (size_t)v[0], c->current + 3 * (size_t)v[1],
+        wci_triangle_normal(c->current + 3 * (size_t)v[0], c->current + 3 * (size_t)v[1],
                            c->current + 3 * (size_t)v[2], c->normals + 3 * (size_t)t);
     }
     c->normals_current = 1;
@@ -362,7 +362,7 @@ static wc_status mesh_begin_step(wc_collider *c, double share)
 static void convex_begin_step(wc_collider *c, double share)
 {
     if (c->moving && share >= 1.0) c->pose_next = c->pose_target;
-    else if (c->moving) wc_pose_lerp(&c->pose_current, &c->pose_target, share, &c->pose_next);
+    else if (c->moving) wci_pose_lerp(&c->pose_current, &c->pose_target, share, &c->pose_next);
     else c->pose_next = c->pose_current;
     const double *p0 = c->pose_current.position, *p1 = c->pose_next.position;
     double r = c->convex.bound_radius;
@@ -372,14 +372,14 @@ static void convex_begin_step(wc_collider *c, double share)
     }
 }
 
-wc_status wc_collider_begin_step(wc_collider *c, double share)
+wc_status wci_collider_begin_step(wc_collider *c, double share)
 {
     if (c->is_mesh) return mesh_begin_step(c, share);
     convex_begin_step(c, share);
     return WC_OK;
 }
 
-void wc_collider_end_step(wc_collider *c)
+void wci_collider_end_step(wc_collider *c)
 {
     if (!c->moving) return;
     if (c->is_mesh) {

@@ -85,16 +85,16 @@ typedef struct wc_collider {
     wc_pose pose_next;
 } wc_collider;
 
-void wc_collider_destroy(wc_collider *collider);
+void wci_collider_destroy(wc_collider *collider);
 
 /// Readies a collider for a step that covers `share` of what is left of the
 /// running advance (1 / substeps left): next = current + (target - current)
 /// * share and its step motion; at the first step of an advance that moves
 /// it (or the first step at all), its boxes over the advance and its tree
 /// (built once, refit after), and the normals of a static one.
-wc_status wc_collider_begin_step(wc_collider *collider, double share);
+wc_status wci_collider_begin_step(wc_collider *collider, double share);
 
 /// After a step that was committed: the collider is now where it was headed.
-void wc_collider_end_step(wc_collider *collider);
+void wci_collider_end_step(wc_collider *collider);
 
 #endif

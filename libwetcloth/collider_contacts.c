@@ -127,8 +127,8 @@ static int compare_edge(const void *pa, const void *pb)
 static int invert_elements(const int32_t *particles, int per, int32_t count, int32_t particle_count,
                            int32_t **start_out, int32_t **items_out)
 {
-    int32_t *start = wc_alloc_array((size_t)particle_count + 1, sizeof *start);
-    int32_t *items = wc_alloc_array((size_t)per * (size_t)count + 1, sizeof *items);
+    int32_t *start = wci_alloc_array((size_t)particle_count + 1, sizeof *start);
+    int32_t *items = wci_alloc_array((size_t)per * (size_t)count + 1, sizeof *items);
     *start_out = start, *items_out = items;
     if (!start || !items) return 0;
     for (size_t k = 0; k < (size_t)per * (size_t)count; ++k) start[particles[k] + 1]++;
@@ -147,10 +147,10 @@ static int invert_elements(const int32_t *particles, int per, int32_t count, int
 static int build_edges(wc_cloth_elements *el)
 {
     int32_t nt = el->triangle_count;
-    int32_t *entries = wc_alloc_array(9 * (size_t)nt + 1, sizeof *entries);
-    el->edges = wc_alloc_array(6 * (size_t)nt + 1, sizeof *el->edges);
+    int32_t *entries = wci_alloc_array(9 * (size_t)nt + 1, sizeof *entries);
+    el->edges = wci_alloc_array(6 * (size_t)nt + 1, sizeof *el->edges);
     if (!entries || !el->edges) {
-        wc_free(entries);
+        wci_free(entries);
         return 0;
     }
     for (int32_t t = 0; t < nt; ++t)
@@ -167,13 +167,13 @@ static int build_edges(wc_cloth_elements *el)
         el->edges[2 * el->edge_count + 1] = e[1];
         ++el->edge_count;
     }
-    wc_free(entries);
+    wci_free(entries);
     return 1;
 }
 
-wc_collider_contacts *wc_collider_contacts_create(const wc_cloth *c)
+wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *c)
 {
-    wc_collider_contacts *s = wc_alloc_array(1, sizeof *s);
+    wc_collider_contacts *s = wci_alloc_array(1, sizeof *s);
     if (!s) return NULL;
     size_t n = (size_t)c->particle_count;
     s->use_filter = 1;
@@ -187,44 +187,44 @@ wc_collider_contacts *wc_collider_contacts_create(const wc_cloth *c)
                              &s->el.edges_start, &s->el.edges_of);
     size_t most = (size_t)(s->el.triangle_count > s->el.edge_count ? s->el.triangle_count
                                                                    : s->el.edge_count) + 1;
-    s->recheck = wc_alloc_array(n, 1);
-    s->shifted = wc_alloc_array(n, 1);
-    s->carry = wc_alloc_array(3 * n, sizeof *s->carry);
-    s->moved = wc_alloc_array(n, 1);
-    s->moving = wc_alloc_array(n, 1);
-    s->moved_list = wc_alloc_array(n, sizeof *s->moved_list);
-    s->moving_list = wc_alloc_array(n, sizeof *s->moving_list);
-    s->rebase_list = wc_alloc_array(n, sizeof *s->rebase_list);
-    s->rebase_flag = wc_alloc_array(n, 1);
-    s->visit_mark = wc_alloc_array(most, 1);
-    s->visit_list = wc_alloc_array(most, sizeof *s->visit_list);
-    s->path = wc_alloc_array(n, sizeof *s->path);
-    s->path_start = wc_alloc_array(n, sizeof *s->path_start);
-    s->last_end = wc_alloc_array(3 * n, sizeof *s->last_end);
-    s->motion = wc_alloc_array(n, sizeof *s->motion);
+    s->recheck = wci_alloc_array(n, 1);
+    s->shifted = wci_alloc_array(n, 1);
+    s->carry = wci_alloc_array(3 * n, sizeof *s->carry);
+    s->moved = wci_alloc_array(n, 1);
+    s->moving = wci_alloc_array(n, 1);
+    s->moved_list = wci_alloc_array(n, sizeof *s->moved_list);
+    s->moving_list = wci_alloc_array(n, sizeof *s->moving_list);
+    s->rebase_list = wci_alloc_array(n, sizeof *s->rebase_list);
+    s->rebase_flag = wci_alloc_array(n, 1);
+    s->visit_mark = wci_alloc_array(most, 1);
+    s->visit_list = wci_alloc_array(most, sizeof *s->visit_list);
+    s->path = wci_alloc_array(n, sizeof *s->path);
+    s->path_start = wci_alloc_array(n, sizeof *s->path_start);
+    s->last_end = wci_alloc_array(3 * n, sizeof *s->last_end);
+    s->motion = wci_alloc_array(n, sizeof *s->motion);
     if (!ok || !s->path || !s->path_start || !s->last_end || !s->motion || !s->recheck || !s->shifted || !s->carry || !s->moved || !s->moving ||
         !s->moved_list || !s->moving_list || !s->rebase_list || !s->rebase_flag ||
         !s->visit_mark || !s->visit_list) {
-        wc_collider_contacts_destroy(s);
+        wci_collider_contacts_destroy(s);
         return NULL;
     }
     return s;
 }
 
-void wc_collider_contacts_destroy(wc_collider_contacts *s)
+void wci_collider_contacts_destroy(wc_collider_contacts *s)
 {
     if (!s) return;
-    for (int32_t k = 0; k < s->cand_count; ++k) wc_candidates_free(&s->cand[k]);
+    for (int32_t k = 0; k < s->cand_count; ++k) wci_candidates_destroy(&s->cand[k]);
     void *blocks[] = {s->cand, s->el.edges, s->el.triangles_start, s->el.triangles_of,
                       s->el.edges_start, s->el.edges_of, s->recheck, s->shifted, s->carry,
                       s->moved, s->moving, s->moved_list, s->moving_list, s->rebase_list,
                       s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->tested, s->measured,
                       s->path, s->path_start, s->last_end, s->motion};
-    for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
-    wc_free(s);
+    for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wci_free(blocks[k]);
+    wci_free(s);
 }
 
-void wc_collider_contacts_use_filter(wc_collider_contacts *s, int use) { s->use_filter = use; }
+void wci_collider_contacts_use_filter(wc_collider_contacts *s, int use) { s->use_filter = use; }
 
 /* ------------------------------------------------------------------------ */
 /* Candidates                                                               */
@@ -246,11 +246,11 @@ static double collider_drift(const wc_collider *col, double path_at)
 static int grow_candidates(wc_collider_contacts *s, int32_t count)
 {
     if (count <= s->cand_count) return 1;
-    wc_candidates *grown = wc_alloc_array((size_t)count, sizeof *grown);
+    wc_candidates *grown = wci_alloc_array((size_t)count, sizeof *grown);
     if (!grown) return 0;
     if (s->cand_count) memcpy(grown, s->cand, (size_t)s->cand_count * sizeof *grown);
-    for (int32_t k = s->cand_count; k < count; ++k) wc_candidates_init(&grown[k]);
-    wc_free(s->cand);
+    for (int32_t k = s->cand_count; k < count; ++k) memset(&grown[k], 0, sizeof grown[k]);
+    wci_free(s->cand);
     s->cand = grown, s->cand_count = count;
     return 1;
 }
@@ -269,7 +269,7 @@ static wc_status flush_rebase(wc_collider_contacts *s, const wc_collider *col, i
     wc_status st = WC_OK;
     wc_particle_paths paths = paths_of(s);
     if (s->rebase_count)
-        st = wc_candidates_rebase(&s->cand[k], &s->el, col, s->rebase_list, s->rebase_count, p,
+        st = wci_candidates_rebase(&s->cand[k], &s->el, col, s->rebase_list, s->rebase_count, p,
                                   &paths, steps_left, s->visit_mark);
     for (int32_t j = 0; j < s->rebase_count; ++j) s->rebase_flag[s->rebase_list[j]] = 0;
     s->rebase_count = 0;
@@ -291,13 +291,13 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         double r = contact_distance(c, col);
         if (cand->r != r) {
             wc_particle_paths paths = paths_of(s);
-            if (wc_candidates_build(cand, &s->el, col, r, p, &paths, steps_left))
+            if (wci_candidates_update(cand, &s->el, col, r, p, &paths, steps_left))
                 return WC_ERROR_OUT_OF_MEMORY;
             continue;
         }
         double path = col->path + col->step_motion;
         for (int32_t i = 0; i < c->particle_count; ++i)
-            if (wc_candidates_half_used(cand, i, wc_candidates_displacement(cand, p, i), path))
+            if (wc_candidates_half_used(cand, i, wci_candidates_displacement(cand, p, i), path))
                 note_rebase(s, i);
         if (flush_rebase(s, col, k, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
     }
@@ -333,7 +333,7 @@ static int answer_particle(particle_run *run, wc_contact *k, const wc_collider *
     wc_response_options none = {0.0};
     k->friction = sqrt(run->mu_cloth * col->friction);
     k->wet_friction = run->q;
-    if (!wc_response_apply(run->p, k, &none, NULL, moved)) return 0;
+    if (!wci_response_apply(run->p, k, &none, NULL, moved)) return 0;
     run->touched = 1;
     for (int m = 0; m < 3; ++m) run->last_motion[m] = k->surface_motion[m];
     return 1;
@@ -345,7 +345,7 @@ static int test_triangle(particle_run *run, const wc_collider *col, int32_t t, d
     double end[3];
     wc_contact k;
     end_now(run, end);
-    if (!wc_narrow_particle_triangle(col, t, run->i, run->start, end, r, &k)) return 0;
+    if (!wci_narrow_particle_triangle(col, t, run->i, run->start, end, r, &k)) return 0;
     return answer_particle(run, &k, col);
 }
 
@@ -392,20 +392,20 @@ static int direct_triangles(particle_run *run, const wc_collider *col, double r,
             box[k + 3] = (run->start[k] < end[k] ? end[k] : run->start[k]) + r;
         }
         int32_t stack[DIRECT_STACK], *found = stack;
-        int32_t n = wc_bvh_query(&col->bvh, box, stack, DIRECT_STACK);
+        int32_t n = wci_bvh_query(&col->bvh, box, stack, DIRECT_STACK);
         if (n > DIRECT_STACK) {
-            found = wc_alloc_array((size_t)n, sizeof *found);
+            found = wci_alloc_array((size_t)n, sizeof *found);
             if (!found) {
                 /* no room for the list: every triangle in turn */
                 for (int32_t t = after + 1; t < col->triangle_count; ++t) moved |= test_triangle(run, col, t, r);
                 return moved;
             }
-            wc_bvh_query(&col->bvh, box, found, n);
+            wci_bvh_query(&col->bvh, box, found, n);
         }
         int32_t pushed = -1;
         for (int32_t j = 0; j < n && pushed < 0; ++j)
             if (found[j] > after && test_triangle(run, col, found[j], r)) pushed = found[j];
-        if (found != stack) wc_free(found);
+        if (found != stack) wci_free(found);
         if (pushed < 0) return moved;
         moved = 1, after = pushed;
     }
@@ -422,7 +422,7 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
     double path = col->path + col->step_motion, drift = collider_drift(col, l->path_at[i]);
     int moved = 0;
     for (;;) {
-        double d = wc_candidates_displacement(cand, p, i);
+        double d = wci_candidates_displacement(cand, p, i);
         if (!wc_candidates_covers(cand, i, d, path)) {
             run->leaves_cover = 1;
             return moved | direct_triangles(run, col, r, after);
@@ -459,7 +459,7 @@ static int particle_passes(wc_collider_contacts *s, const wc_cloth *c, wc_collid
                 double end[3];
                 wc_contact ct;
                 end_now(run, end);
-                if (wc_narrow_particle_convex(col, run->i, run->start, end, r, &ct))
+                if (wci_narrow_particle_convex(col, run->i, run->start, end, r, &ct))
                     moved |= answer_particle(run, &ct, col);
             }
         }
@@ -556,7 +556,7 @@ static wc_status note_pushed(wc_collider_contacts *s, const wc_particle_arrays *
         double path = col->path + col->step_motion;
         for (int j = 0; j < k->count; ++j)
             if (moved[j] && !wc_candidates_covers(&s->cand[c], k->particle[j],
-                                                  wc_candidates_displacement(&s->cand[c], p, k->particle[j]), path))
+                                                  wci_candidates_displacement(&s->cand[c], p, k->particle[j]), path))
                 note_rebase(s, k->particle[j]);
         if (flush_rebase(s, col, c, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
     }
@@ -573,14 +573,14 @@ static int feature_scratch(wc_collider_contacts *s, int32_t n)
 {
     if (n <= s->kept_capacity && n <= s->tested_capacity) return 1;
     int32_t cap = 2 * n + 16;
-    int32_t *kept = wc_alloc_array((size_t)cap, sizeof *kept);
-    uint8_t *tested = wc_alloc_array((size_t)cap, 1);
-    double *measured = wc_alloc_array((size_t)cap, sizeof *measured);
+    int32_t *kept = wci_alloc_array((size_t)cap, sizeof *kept);
+    uint8_t *tested = wci_alloc_array((size_t)cap, 1);
+    double *measured = wci_alloc_array((size_t)cap, sizeof *measured);
     if (!kept || !tested || !measured) {
-        wc_free(kept), wc_free(tested), wc_free(measured);
+        wci_free(kept), wci_free(tested), wci_free(measured);
         return 0;
     }
-    wc_free(s->kept), wc_free(s->tested), wc_free(s->measured);
+    wci_free(s->kept), wci_free(s->tested), wci_free(s->measured);
     s->kept = kept, s->tested = tested, s->measured = measured;
     s->kept_capacity = s->tested_capacity = cap;
     return 1;
@@ -600,7 +600,7 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
     const wc_pair_lists *l = kind->lists;
     wc_particle_paths paths = paths_of(s);
     double reach = feature_reach(r) + FILTER_EPSILON(r);
-    double drift = wc_pair_lists_drift(l, e, idx, &paths) + collider_drift(col, l->path_at[e]);
+    double drift = wci_pair_lists_drift(l, e, idx, &paths) + collider_drift(col, l->path_at[e]);
     /* nothing in the list can touch: the cheap way out of most visits */
     if (!s->use_filter ? l->count[e] == 0 : l->least[e] - drift > reach) return 0;
     double mu = sqrt(c->material.friction * col->friction);
@@ -620,24 +620,24 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
         for (int32_t j = 0; j < n && hit < 0; ++j) {
             int32_t at = s->kept[j], f = l->item[l->start[e] + at];
             double fm = feature_motion(col, kind, f);
-            int ccd = wc_narrow_needs_ccd(motion > fm ? motion : fm, r);
+            int ccd = wci_narrow_needs_ccd(motion > fm ? motion : fm, r);
             double d2;
             wc_contact ct;
-            int touch = kind->count == 3 ? wc_narrow_vertex_triangle(p, idx, col, f, ccd, r, &d2, &ct)
-                                         : wc_narrow_edge_edge(p, idx, col, f, ccd, r, &d2, &ct);
+            int touch = kind->count == 3 ? wci_narrow_vertex_triangle(p, idx, col, f, ccd, r, &d2, &ct)
+                                         : wci_narrow_edge_edge(p, idx, col, f, ccd, r, &d2, &ct);
             s->tested[at] = 1, s->measured[at] = sqrt(d2);
             if (!touch) continue;
             ct.friction = mu, ct.wet_friction = c->material.wet_friction;
             uint8_t moved[4];
             wc_response_options none = {0.0};
-            if (!wc_response_apply(p, &ct, &none, NULL, moved)) continue;
+            if (!wci_response_apply(p, &ct, &none, NULL, moved)) continue;
             if (note_pushed(s, p, colliders, count, &ct, moved, steps_left)) return -1;
             hit = f;
         }
         if (hit < 0) break;
         pushed = 1, after = hit;
         /* the push moved the element (and perhaps rebased its list) */
-        drift = wc_pair_lists_drift(l, e, idx, &paths) + collider_drift(col, l->path_at[e]);
+        drift = wci_pair_lists_drift(l, e, idx, &paths) + collider_drift(col, l->path_at[e]);
     }
     if (!pushed) {
         /* measured at the ends as they are: a fresh snapshot */
@@ -646,7 +646,7 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
         for (int j = 0; j < kind->count; ++j)
             if (s->path[idx[j]] - snap[j] > end_drift) end_drift = s->path[idx[j]] - snap[j];
         end_drift += collider_drift(col, l->path_at[e]);
-        wc_pair_lists_renew((wc_pair_lists *)l, e, idx, &paths, col->path + col->step_motion,
+        wci_pair_lists_renew((wc_pair_lists *)l, e, idx, &paths, col->path + col->step_motion,
                             s->tested, s->measured, end_drift);
     }
     return pushed;
@@ -761,12 +761,12 @@ static int feature_pass(wc_collider_contacts *s, wc_cloth *c, const wc_particle_
 /* The stage                                                                */
 /* ------------------------------------------------------------------------ */
 
-wc_status wc_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
+wc_status wci_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
                                        wc_collider *const *colliders, int32_t count,
                                        int32_t steps_left, int threads, wc_step_stats *stats)
 {
     if (count <= 0) return WC_OK;
-    wc_particle_arrays p = wc_particle_arrays_of(c);
+    wc_particle_arrays p = wci_particle_arrays_of(c);
     begin_paths(s, &p);
     if (refresh_candidates(s, c, colliders, count, &p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
     memset(s->shifted, 0, (size_t)c->particle_count);
@@ -780,7 +780,7 @@ wc_status wc_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
             double path = colliders[k]->path + colliders[k]->step_motion;
             for (int32_t i = 0; i < c->particle_count; ++i)
                 if (s->shifted[i] &&
-                    !wc_candidates_covers(&s->cand[k], i, wc_candidates_displacement(&s->cand[k], &p, i), path))
+                    !wc_candidates_covers(&s->cand[k], i, wci_candidates_displacement(&s->cand[k], &p, i), path))
                     note_rebase(s, i);
             if (flush_rebase(s, colliders[k], k, &p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
         }

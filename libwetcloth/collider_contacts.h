@@ -34,23 +34,23 @@
 typedef struct wc_collider_contacts wc_collider_contacts;
 
 /// NULL on out-of-memory.
-wc_collider_contacts *wc_collider_contacts_create(const wc_cloth *cloth);
-void wc_collider_contacts_destroy(wc_collider_contacts *state);
+wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *cloth);
+void wci_collider_contacts_destroy(wc_collider_contacts *state);
 
 /// Resolves the cloth's motion x -> nx against every collider: moves nx,
 /// sets history overrides and collider contacts (kind and normal). The
-/// colliders have begun their step (wc_collider_begin_step). `steps_left`
+/// colliders have begun their step (wci_collider_begin_step). `steps_left`
 /// is how many steps of the running advance follow this one (the
 /// candidates' margins look that far ahead). Adds fail-safe particles to
 /// stats. Deterministic for any thread count. WC_ERROR_OUT_OF_MEMORY on
 /// out-of-memory.
-wc_status wc_collider_contacts_resolve(wc_cloth *cloth, wc_collider_contacts *state,
+wc_status wci_collider_contacts_resolve(wc_cloth *cloth, wc_collider_contacts *state,
                                        wc_collider *const *colliders, int32_t collider_count,
                                        int32_t steps_left, int threads, wc_step_stats *stats);
 
 /// Test switch: 1 (default) skips the pairs the filter proves apart, 0
 /// gives every listed pair the exact test. The results are the same bit for
 /// bit; tests compare the two.
-void wc_collider_contacts_use_filter(wc_collider_contacts *state, int use);
+void wci_collider_contacts_use_filter(wc_collider_contacts *state, int use);
 
 #endif

@@ -22,14 +22,14 @@ static const unsigned char *get(const unsigned char *at, void *to, size_t bytes)
     return at + bytes;
 }
 
-int wc_contact_backup_save(wc_contact_backup *b, wc_cloth *const *cloths, int32_t count)
+int wci_contact_backup_save(wc_contact_backup *b, wc_cloth *const *cloths, int32_t count)
 {
     size_t total = 0;
     for (int32_t k = 0; k < count; ++k) total += cloth_bytes(cloths[k]);
     if (total > b->capacity) {
-        unsigned char *grown = wc_alloc_array(total, 1);
+        unsigned char *grown = wci_alloc_array(total, 1);
         if (!grown) return 1;
-        wc_free(b->bytes);
+        wci_free(b->bytes);
         b->bytes = grown;
         b->capacity = total;
     }
@@ -48,7 +48,7 @@ int wc_contact_backup_save(wc_contact_backup *b, wc_cloth *const *cloths, int32_
     return 0;
 }
 
-void wc_contact_backup_restore(const wc_contact_backup *b, wc_cloth *const *cloths, int32_t count)
+void wci_contact_backup_restore(const wc_contact_backup *b, wc_cloth *const *cloths, int32_t count)
 {
     const unsigned char *at = b->bytes;
     for (int32_t k = 0; k < count; ++k) {
@@ -69,9 +69,9 @@ void wc_contact_backup_restore(const wc_contact_backup *b, wc_cloth *const *clot
     }
 }
 
-void wc_contact_backup_free(wc_contact_backup *b)
+void wci_contact_backup_destroy(wc_contact_backup *b)
 {
-    wc_free(b->bytes);
+    wci_free(b->bytes);
     b->bytes = NULL;
     b->capacity = 0;
 }

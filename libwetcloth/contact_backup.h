@@ -20,13 +20,13 @@ typedef struct wc_contact_backup {
 
 /// Saves the cloths' contact state; non-zero when out of memory (then
 /// nothing was changed).
-int wc_contact_backup_save(wc_contact_backup *backup, wc_cloth *const *cloths, int32_t count);
+int wci_contact_backup_save(wc_contact_backup *backup, wc_cloth *const *cloths, int32_t count);
 
 /// Puts back what the last save saved, and drops the self-contacts a failed
 /// step had recorded.
-void wc_contact_backup_restore(const wc_contact_backup *backup, wc_cloth *const *cloths,
+void wci_contact_backup_restore(const wc_contact_backup *backup, wc_cloth *const *cloths,
                                int32_t count);
 
-void wc_contact_backup_free(wc_contact_backup *backup);
+void wci_contact_backup_destroy(wc_contact_backup *backup);
 
 #endif

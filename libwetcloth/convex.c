@@ -102,26 +102,26 @@ static void quat_rotate(const double q[4], int inverse, const double v[3], doubl
     for (int k = 0; k < 3; ++k) out[k] = v[k] + q[0] * t[k] + ut[k];
 }
 
-void wc_pose_rotate(const wc_pose *pose, const double v[3], double out[3])
+void wci_pose_rotate(const wc_pose *pose, const double v[3], double out[3])
 {
     quat_rotate(pose->rotation, 0, v, out);
 }
 
-void wc_pose_to_world(const wc_pose *pose, const double local[3], double world[3])
+void wci_pose_to_world(const wc_pose *pose, const double local[3], double world[3])
 {
     double r[3];
     quat_rotate(pose->rotation, 0, local, r);
     for (int k = 0; k < 3; ++k) world[k] = pose->position[k] + r[k];
 }
 
-void wc_pose_to_local(const wc_pose *pose, const double world[3], double local[3])
+void wci_pose_to_local(const wc_pose *pose, const double world[3], double local[3])
 {
     double d[3];
     for (int k = 0; k < 3; ++k) d[k] = world[k] - pose->position[k];
     quat_rotate(pose->rotation, 1, d, local);
 }
 
-void wc_pose_lerp(const wc_pose *a, const wc_pose *b, double t, wc_pose *out)
+void wci_pose_lerp(const wc_pose *a, const wc_pose *b, double t, wc_pose *out)
 {
     /* The ends are returned bit for bit, so a collider that stops moving
      * ends exactly at its target. */
@@ -158,7 +158,7 @@ static wc_status check_length(wc_message *msg, const char *field, double value, 
 {
     int ok = isfinite(value) && value <= MAX_LENGTH && (zero_ok ? value >= 0.0 : value > 0.0);
     if (ok) return WC_OK;
-    return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "convex_collider_def.%s must be in %s0, 1e6] m but is %g",
+    return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "convex_collider_def.%s must be in %s0, 1e6] m but is %g",
                    field, zero_ok ? "[" : "(", value);
 }
 
@@ -196,34 +196,34 @@ static int hull_has_volume(const double *p, int32_t n)
     return vol / 6.0 > 1e-12 * ext * ext * ext;
 }
 
-wc_status wc_convex_shape_init(wc_convex_shape *shape, wc_pose *pose,
+wc_status wci_convex_shape_create(wc_convex_shape *shape, wc_pose *pose,
                                const wc_convex_collider_def *def, wc_message *msg)
 {
     memset(shape, 0, sizeof *shape);
     if (!def)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT, "convex_collider_def is NULL");
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT, "convex_collider_def is NULL");
     if (def->shape != WC_SHAPE_SPHERE && def->shape != WC_SHAPE_CAPSULE &&
         def->shape != WC_SHAPE_BOX && def->shape != WC_SHAPE_CONVEX_HULL)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "convex_collider_def.shape must be WC_SHAPE_SPHERE (0), WC_SHAPE_CAPSULE (1), "
                        "WC_SHAPE_BOX (2) or WC_SHAPE_CONVEX_HULL (3) but is %d",
                        (int)def->shape);
     for (int k = 0; k < 3; ++k)
         if (!isfinite(def->position[k]))
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "convex_collider_def.position[%d] must be finite but is %g", k,
                            def->position[k]);
     double qn = 0.0;
     for (int k = 0; k < 4; ++k) {
         if (!isfinite(def->rotation[k]))
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "convex_collider_def.rotation[%d] must be finite but is %g", k,
                            def->rotation[k]);
         qn += def->rotation[k] * def->rotation[k];
     }
     qn = sqrt(qn);
     if (!(qn > 1e-12) || !isfinite(qn))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "convex_collider_def.rotation must be a non-zero quaternion (w, x, y, z) but "
                        "has norm %g",
                        qn);
@@ -243,24 +243,24 @@ wc_status wc_convex_shape_init(wc_convex_shape *shape, wc_pose *pose,
         break;
     case WC_SHAPE_CONVEX_HULL:
         if (def->point_count < MIN_HULL_POINTS || def->point_count > MAX_HULL_POINTS)
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "convex_collider_def.point_count must be in [%d, %d] but is %d",
                            MIN_HULL_POINTS, MAX_HULL_POINTS, (int)def->point_count);
         if (!def->points)
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "convex_collider_def.points is NULL (point_count is %d)",
                            (int)def->point_count);
         for (int32_t i = 0; i < def->point_count; ++i)
             for (int k = 0; k < 3; ++k) {
                 double v = def->points[3 * i + k];
                 if (!isfinite(v) || fabs(v) > MAX_LENGTH)
-                    return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                    return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                                    "convex_collider_def.points[%d] %c is %g; coordinates must be "
                                    "finite and within 1e6 m",
                                    (int)i, "xyz"[k], v);
             }
         if (!hull_has_volume(def->points, def->point_count))
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "convex_collider_def.points must span a volume, but the %d points lie "
                            "in one plane (or line)",
                            (int)def->point_count);
@@ -268,10 +268,10 @@ wc_status wc_convex_shape_init(wc_convex_shape *shape, wc_pose *pose,
     }
     if (s) return s;
     if (!(isfinite(def->thickness) && def->thickness >= 0.0 && def->thickness <= 1.0))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "convex_collider_def.thickness must be in [0, 1] m but is %g", def->thickness);
     if (!(isfinite(def->friction) && def->friction >= 0.0 && def->friction <= 10.0))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "convex_collider_def.friction must be in [0, 10] but is %g", def->friction);
 
     shape->shape = def->shape;
@@ -291,9 +291,9 @@ wc_status wc_convex_shape_init(wc_convex_shape *shape, wc_pose *pose,
         break;
     case WC_SHAPE_CONVEX_HULL: {
         size_t n = (size_t)def->point_count;
-        shape->points = wc_alloc_array(3 * n, sizeof *shape->points);
+        shape->points = wci_alloc_array(3 * n, sizeof *shape->points);
         if (!shape->points)
-            return wc_fail(msg, WC_ERROR_OUT_OF_MEMORY,
+            return wci_fail(msg, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory copying %d convex hull points", (int)def->point_count);
         memcpy(shape->points, def->points, 3 * n * sizeof *shape->points);
         shape->point_count = def->point_count;
@@ -311,10 +311,10 @@ wc_status wc_convex_shape_init(wc_convex_shape *shape, wc_pose *pose,
     return WC_OK;
 }
 
-void wc_convex_shape_free(wc_convex_shape *shape)
+void wci_convex_shape_destroy(wc_convex_shape *shape)
 {
     if (!shape) return;
-    wc_free(shape->points);
+    wci_free(shape->points);
     shape->points = NULL;
     shape->point_count = 0;
 }
@@ -761,7 +761,7 @@ static int penetration_raw(const wc_convex_shape *s, const double c[3], double r
     return mpr_ball(s, c, r, scale, depth, dir);
 }
 
-int wc_convex_penetration(const wc_convex_shape *shape, const double c[3], double r, double *depth,
+int wci_convex_penetration(const wc_convex_shape *shape, const double c[3], double r, double *depth,
                           double dir[3])
 {
     double d, v[3];
@@ -857,7 +857,7 @@ static double first_contact(const wc_convex_shape *s, const double a[3], const d
     return hi;
 }
 
-int wc_convex_resolve(const wc_convex_shape *shape, const double a[3], const double b[3], double r,
+int wci_convex_resolve(const wc_convex_shape *shape, const double a[3], const double b[3], double r,
                       double out[3], double normal[3])
 {
     /* Cheapest test first: the path never comes within r of the shape's
@@ -865,7 +865,7 @@ int wc_convex_resolve(const wc_convex_shape *shape, const double a[3], const dou
     if (segment_origin_distance(a, b) > shape->bound_radius + r) return 0;
     double scale = scale_of(shape, r);
     double db = 0.0, vb[3] = {0.0, 0.0, 0.0};
-    int in_b = wc_convex_penetration(shape, b, r, &db, vb);
+    int in_b = wci_convex_penetration(shape, b, r, &db, vb);
     double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     double len = norm3(ab);
     /* A particle that moves less than r in the step cannot pass through
@@ -880,7 +880,7 @@ int wc_convex_resolve(const wc_convex_shape *shape, const double a[3], const dou
      * it ends is checked. */
     if (len > r && isfinite(len)) {
         double da, va[3];
-        int in_a = wc_convex_penetration(shape, a, r, &da, va);
+        int in_a = wci_convex_penetration(shape, a, r, &da, va);
         /* The sweep with half the radius asks whether the path really went
          * through: grazing chords over a curved surface (a sliding particle
          * dips in by len^2 / 8R) are not collisions. */
@@ -919,15 +919,15 @@ int wc_convex_resolve(const wc_convex_shape *shape, const double a[3], const dou
 /* Triangles (for the intersection checker)                                  */
 /* ------------------------------------------------------------------------ */
 
-int wc_convex_triangle_intersects(const wc_convex_shape *shape, const wc_pose *pose,
+int wci_convex_triangle_intersects(const wc_convex_shape *shape, const wc_pose *pose,
                                   const double a[3], const double b[3], const double c[3])
 {
     probe_obj tri;
     memset(&tri, 0, sizeof tri);
     tri.kind = 3;
-    wc_pose_to_local(pose, a, tri.a);
-    wc_pose_to_local(pose, b, tri.b);
-    wc_pose_to_local(pose, c, tri.c);
+    wci_pose_to_local(pose, a, tri.a);
+    wci_pose_to_local(pose, b, tri.b);
+    wci_pose_to_local(pose, c, tri.c);
     /* Cheap rejection: the triangle's box misses the bounding ball. */
     double gap2 = 0.0, far = 0.0;
     for (int k = 0; k < 3; ++k) {
@@ -941,7 +941,7 @@ int wc_convex_triangle_intersects(const wc_convex_shape *shape, const wc_pose *p
     if (gap2 > shape->bound_radius * shape->bound_radius) return 0;
     /* A vertex that is not finite in the shape's frame (or a triangle so
      * large its centre overflows) gets no answer from libccd, only
-     * infinities inside GJK, as wc_convex_resolve's overflowing paths did
+     * infinities inside GJK, as wci_convex_resolve's overflowing paths did
      * inside EPA: it is not counted. */
     for (int k = 0; k < 3; ++k)
         if (!isfinite(tri.center[k])) return 0;

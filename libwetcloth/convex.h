@@ -15,9 +15,9 @@
 /// half_extents, points/point_count spanning a volume, rotation non-zero and
 /// finite, position finite, thickness, friction) naming the first bad field,
 /// and fills the shape (hull points copied) and the normalised pose.
-wc_status wc_convex_shape_init(wc_convex_shape *shape, wc_pose *pose,
+wc_status wci_convex_shape_create(wc_convex_shape *shape, wc_pose *pose,
                                const wc_convex_collider_def *def, wc_message *msg);
-void wc_convex_shape_free(wc_convex_shape *shape);
+void wci_convex_shape_destroy(wc_convex_shape *shape);
 
 /// Penetration of a ball (centre c, radius r, local coordinates) into the
 /// shape: the smallest one, exact to rounding (convex.c says why this is not
@@ -26,7 +26,7 @@ void wc_convex_shape_free(wc_convex_shape *shape);
 /// -depth * dir separates them. Returns 0 when they do not touch; a
 /// penetration below 1e-10 of (bounding radius + r) counts as touching, so a
 /// ball just put at distance r is not found in contact again by rounding.
-int wc_convex_penetration(const wc_convex_shape *shape, const double c[3], double r,
+int wci_convex_penetration(const wc_convex_shape *shape, const double c[3], double r,
                           double *depth, double dir[3]);
 
 /// A particle moving from a to b (local coordinates) as a ball of radius r.
@@ -34,22 +34,22 @@ int wc_convex_penetration(const wc_convex_shape *shape, const double c[3], doubl
 /// that would pass through is caught at its first contact); then writes the
 /// position it may have at the end of the step (on the surface, at distance r)
 /// and the outward unit normal there. Returns 0 (outputs untouched) otherwise.
-int wc_convex_resolve(const wc_convex_shape *shape, const double a[3], const double b[3],
+int wci_convex_resolve(const wc_convex_shape *shape, const double a[3], const double b[3],
                       double r, double out[3], double normal[3]);
 
 /// Whether triangle (a, b, c), world coordinates, reaches inside the shape at
 /// the pose (thickness ignored). For the intersection checker.
-int wc_convex_triangle_intersects(const wc_convex_shape *shape, const wc_pose *pose,
+int wci_convex_triangle_intersects(const wc_convex_shape *shape, const wc_pose *pose,
                                   const double a[3], const double b[3], const double c[3]);
 
 /// World to local coordinates of a point.
-void wc_pose_to_local(const wc_pose *pose, const double world[3], double local[3]);
+void wci_pose_to_local(const wc_pose *pose, const double world[3], double local[3]);
 /// Local to world coordinates of a point.
-void wc_pose_to_world(const wc_pose *pose, const double local[3], double world[3]);
+void wci_pose_to_world(const wc_pose *pose, const double local[3], double world[3]);
 /// Rotates a vector from local to world (no translation).
-void wc_pose_rotate(const wc_pose *pose, const double v[3], double out[3]);
+void wci_pose_rotate(const wc_pose *pose, const double v[3], double out[3]);
 /// Pose a fraction t of the way from a to b: positions linearly, rotations
 /// by normalised linear interpolation along the shorter arc.
-void wc_pose_lerp(const wc_pose *a, const wc_pose *b, double t, wc_pose *out);
+void wci_pose_lerp(const wc_pose *a, const wc_pose *b, double t, wc_pose *out);
 
 #endif

@@ -37,7 +37,7 @@ static void compute_velocities(force_pass *pass, int threads)
         for (int32_t i = 0; i < n; ++i) c->vx[i] = c->px[i], c->vy[i] = c->py[i], c->vz[i] = c->pz[i];
         return;
     }
-    wc_parallel_for(n, wc_threads_for(n, threads), velocities_range, pass);
+    wci_parallel_for(n, wc_threads_for(n, threads), velocities_range, pass);
 }
 
 /* Thesis eq. 2.1, restoring: f_a = -K (d - l) u when d > l, none otherwise.
@@ -140,7 +140,7 @@ static int gather_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-void wc_forces_compute(wc_cloth *c, const double gravity[3], int threads)
+void wci_forces_compute(wc_cloth *c, const double gravity[3], int threads)
 {
     force_pass pass = {c, gravity};
     int32_t n = c->particle_count, stretch = c->topology.stretch.count;
@@ -149,7 +149,7 @@ void wc_forces_compute(wc_cloth *c, const double gravity[3], int threads)
     /* Under XPBD the stretch links are constraints (xpbd.c), not forces:
      * their entries in link_fx stay at zero from the allocation. */
     if (c->integrator != WC_INTEGRATOR_XPBD)
-        wc_parallel_for(stretch, wc_threads_for(stretch, threads), stretch_range, &pass);
-    wc_parallel_for(bend, wc_threads_for(bend, threads), bend_range, &pass);
-    wc_parallel_for(n, wc_threads_for(n, threads), gather_range, &pass);
+        wci_parallel_for(stretch, wc_threads_for(stretch, threads), stretch_range, &pass);
+    wci_parallel_for(bend, wc_threads_for(bend, threads), bend_range, &pass);
+    wci_parallel_for(n, wc_threads_for(n, threads), gather_range, &pass);
 }

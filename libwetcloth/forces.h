@@ -10,6 +10,6 @@
 /// links in a fixed order: no two threads ever write the same value.
 /// A cloth stepped by XPBD gets no stretch link forces (its stretch links
 /// are constraints).
-void wc_forces_compute(wc_cloth *cloth, const double gravity[3], int threads);
+void wci_forces_compute(wc_cloth *cloth, const double gravity[3], int threads);
 
 #endif

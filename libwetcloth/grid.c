@@ -11,15 +11,14 @@
 /* A query spanning more cells than this scans all items instead. */
 #define MAX_CELLS_PER_QUERY 4096
 
-void wc_grid_init(wc_grid *g) { memset(g, 0, sizeof *g); }
 
-void wc_grid_free(wc_grid *g)
+void wci_grid_destroy(wc_grid *g)
 {
-    wc_free(g->start);
-    wc_free(g->items);
-    wc_free(g->large);
-    wc_free(g->corner);
-    wc_grid_init(g);
+    wci_free(g->start);
+    wci_free(g->items);
+    wci_free(g->large);
+    wci_free(g->corner);
+    memset(g, 0, sizeof *g);
 }
 
 /* Cell coordinate of a value; clamped so huge coordinates cannot overflow,
@@ -90,7 +89,7 @@ static void insert_item(wc_grid *g, int32_t item, const int32_t lo[3], const int
             }
 }
 
-wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double cell_size)
+wc_status wci_grid_update(wc_grid *g, const double *boxes, int32_t count, double cell_size)
 {
     g->boxes = boxes;
     g->item_count = count;
@@ -99,15 +98,15 @@ wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double c
     int64_t buckets = 64;
     while (buckets < 2 * (int64_t)count) buckets *= 2;
     if (buckets > g->table_capacity) {
-        wc_free(g->start);
-        g->start = wc_alloc_array((size_t)buckets + 1, sizeof *g->start);
+        wci_free(g->start);
+        g->start = wci_alloc_array((size_t)buckets + 1, sizeof *g->start);
         g->table_capacity = g->start ? buckets : 0;
         if (!g->start) return WC_ERROR_OUT_OF_MEMORY;
     }
     g->bucket_mask = (uint32_t)(buckets - 1);
     if (count > g->corner_capacity) {
-        wc_free(g->corner);
-        g->corner = wc_alloc_array(3 * (size_t)count, sizeof *g->corner);
+        wci_free(g->corner);
+        g->corner = wci_alloc_array(3 * (size_t)count, sizeof *g->corner);
         g->corner_capacity = g->corner ? count : 0;
         if (!g->corner) return WC_ERROR_OUT_OF_MEMORY;
     }
@@ -128,15 +127,15 @@ wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double c
     }
     if (entries > g->entry_capacity || large > 0) {
         if (entries > g->entry_capacity) {
-            wc_free(g->items);
-            g->items = wc_alloc_array((size_t)entries, sizeof *g->items);
+            wci_free(g->items);
+            g->items = wci_alloc_array((size_t)entries, sizeof *g->items);
             g->entry_capacity = g->items ? entries : 0;
         }
-        wc_free(g->large);
-        g->large = large ? wc_alloc_array((size_t)large, sizeof *g->large) : NULL;
+        wci_free(g->large);
+        g->large = large ? wci_alloc_array((size_t)large, sizeof *g->large) : NULL;
         if ((entries && !g->items) || (large && !g->large)) return WC_ERROR_OUT_OF_MEMORY;
     }
-    int32_t *fill = wc_alloc_array((size_t)buckets, sizeof *fill);
+    int32_t *fill = wci_alloc_array((size_t)buckets, sizeof *fill);
     if (!fill) return WC_ERROR_OUT_OF_MEMORY;
     for (int64_t b = 0; b < buckets; ++b) g->start[b + 1] += g->start[b];
     g->large_count = 0;
@@ -156,7 +155,7 @@ wc_status wc_grid_build(wc_grid *g, const double *boxes, int32_t count, double c
         for (int32_t k = 0; k < fill[b]; ++k) g->items[write++] = g->items[begin + k];
     }
     g->start[buckets] = write;
-    wc_free(fill);
+    wci_free(fill);
     return WC_OK;
 }
 
@@ -205,7 +204,7 @@ static int32_t query_one_cell(const wc_grid *g, const double box[6], const int32
     return n;
 }
 
-int32_t wc_grid_query(const wc_grid *g, const double box[6], int32_t *out, int32_t capacity)
+int32_t wci_grid_query(const wc_grid *g, const double box[6], int32_t *out, int32_t capacity)
 {
     int32_t n = 0;
     for (int32_t k = 0; k < g->large_count; ++k)

@@ -30,17 +30,16 @@ typedef struct wc_grid {
 } wc_grid;
 
 /// Empty grid (no memory).
-void wc_grid_init(wc_grid *grid);
-void wc_grid_free(wc_grid *grid);
+void wci_grid_destroy(wc_grid *grid);
 
 /// (Re)builds the grid over `count` boxes (6 doubles each, kept by pointer:
 /// they must outlive the queries) with cubic cells of cell_size metres.
 /// Reuses its memory when large enough. WC_ERROR_OUT_OF_MEMORY on failure.
-wc_status wc_grid_build(wc_grid *grid, const double *boxes, int32_t count, double cell_size);
+wc_status wci_grid_update(wc_grid *grid, const double *boxes, int32_t count, double cell_size);
 
 /// Writes into out (up to capacity) the items overlapping box, ascending and
 /// unique, and returns how many there are (which may exceed capacity).
-int32_t wc_grid_query(const wc_grid *grid, const double box[6], int32_t *out, int32_t capacity);
+int32_t wci_grid_query(const wc_grid *grid, const double box[6], int32_t *out, int32_t capacity);
 
 /// Whether two boxes overlap (touching counts). Inline: the collision
 /// passes call it for every candidate pair.

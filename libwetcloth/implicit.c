@@ -68,59 +68,59 @@ struct wc_implicit_state {
     double last_residual;
 };
 
-void wc_implicit_state_destroy(wc_implicit_state *s)
+void wci_implicit_state_destroy(wc_implicit_state *s)
 {
     if (!s) return;
     double *arrays[] = {s->block, s->kv, s->mass_diag, s->precond, s->v0, s->fixed, s->rhs,
                         s->y, s->r, s->r_next, s->z, s->p, s->q, s->partial,
                         s->link_product};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wc_free(arrays[i]);
-    wc_free(s->end_a);
-    wc_free(s->end_b);
-    wc_multigrid_destroy(s->multigrid);
-    wc_free(s);
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wci_free(arrays[i]);
+    wci_free(s->end_a);
+    wci_free(s->end_b);
+    wci_multigrid_destroy(s->multigrid);
+    wci_free(s);
 }
 
-wc_implicit_state *wc_implicit_state_create(const wc_cloth *c)
+wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
 {
-    wc_implicit_state *s = wc_alloc_array(1, sizeof *s);
+    wc_implicit_state *s = wci_alloc_array(1, sizeof *s);
     if (!s) return NULL;
     const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
     size_t n = (size_t)c->particle_count, links = (size_t)st->count + (size_t)bd->count;
     s->n = c->particle_count;
     s->links = (int32_t)links;
     s->blocks = (int32_t)((n + BLOCK - 1) / BLOCK);
-    s->end_a = wc_alloc_array(links, sizeof *s->end_a);
-    s->end_b = wc_alloc_array(links, sizeof *s->end_b);
-    s->block = wc_alloc_array(6 * links, sizeof(double));
-    s->kv = wc_alloc_array(3 * links, sizeof(double));
-    s->mass_diag = wc_alloc_array(n, sizeof(double));
-    s->precond = wc_alloc_array(6 * n, sizeof(double));
+    s->end_a = wci_alloc_array(links, sizeof *s->end_a);
+    s->end_b = wci_alloc_array(links, sizeof *s->end_b);
+    s->block = wci_alloc_array(6 * links, sizeof(double));
+    s->kv = wci_alloc_array(3 * links, sizeof(double));
+    s->mass_diag = wci_alloc_array(n, sizeof(double));
+    s->precond = wci_alloc_array(6 * n, sizeof(double));
     double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r,
                           &s->r_next, &s->z, &s->p, &s->q};
     int ok = 1;
     for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
-        ok &= (*vectors[i] = wc_alloc_array(3 * n, sizeof(double))) != NULL;
-    s->partial = wc_alloc_array(PARTIAL_SETS * (size_t)s->blocks, sizeof(double));
-    s->link_product = wc_alloc_array(3 * links + 1, sizeof(double));
+        ok &= (*vectors[i] = wci_alloc_array(3 * n, sizeof(double))) != NULL;
+    s->partial = wci_alloc_array(PARTIAL_SETS * (size_t)s->blocks, sizeof(double));
+    s->link_product = wci_alloc_array(3 * links + 1, sizeof(double));
     if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
         !s->partial || !s->link_product) {
-        wc_implicit_state_destroy(s);
+        wci_implicit_state_destroy(s);
         return NULL;
     }
     for (int32_t e = 0; e < st->count; ++e) s->end_a[e] = st->a[e], s->end_b[e] = st->b[e];
     for (int32_t e = 0; e < bd->count; ++e)
         s->end_a[st->count + e] = bd->a[e], s->end_b[st->count + e] = bd->b[e];
-    if (wc_multigrid_create(s->n, s->links, s->end_a, s->end_b, st->count, c->link_start,
+    if (wci_multigrid_create(s->n, s->links, s->end_a, s->end_b, st->count, c->link_start,
                             c->link_list, &s->multigrid)) {
-        wc_implicit_state_destroy(s);
+        wci_implicit_state_destroy(s);
         return NULL;
     }
     return s;
 }
 
-int32_t wc_implicit_last_iterations(const wc_implicit_state *s) { return s->last_iterations; }
-double wc_implicit_last_residual(const wc_implicit_state *s) { return s->last_residual; }
+int32_t wci_implicit_last_iterations(const wc_implicit_state *s) { return s->last_iterations; }
+double wci_implicit_last_residual(const wc_implicit_state *s) { return s->last_residual; }
 
 /* d|f|/d(compression) of the ramped buckling force, N/m, >= 0 (the force
  * grows as the link shortens): the axial stiffness of a compressed bend
@@ -144,13 +144,13 @@ static double buckling_slope(double d, double l, double R)
 }
 
 /* What the loops of one step need, each a part of it: the loops run
- * through wc_parallel_for (parallel.h), which passes one pointer. */
+ * through wci_parallel_for (parallel.h), which passes one pointer. */
 typedef struct implicit_pass {
     const wc_cloth *cloth;
     wc_implicit_state *state;
     double h, pin_fraction;
     /* the part of the velocity change that the positions take: x+ = x + h
-     * (v0 + share dv), share = (h + h_prev) / 2h (see wc_integrate_implicit) */
+     * (v0 + share dv), share = (h + h_prev) / 2h (see wci_integrate_implicit) */
     double share;
     /* apply: out = A in; updates: the factor */
     const double *in;
@@ -237,7 +237,7 @@ static int start_velocities_range(void *context, int64_t begin, int64_t end)
         fx[0] = fx[1] = fx[2] = 0.0;
         if (c->pin_slot[i] >= 0) {
             double p[3];
-            wc_pinned_position(c, c->pin_slot[i], pin_fraction, p);
+            wci_pinned_position(c, c->pin_slot[i], pin_fraction, p);
             double share = pass->share;
             fx[0] = ((p[0] - c->x[i]) / h - v[0]) / share;
             fx[1] = ((p[1] - c->y[i]) / h - v[1]) / share;
@@ -302,7 +302,7 @@ static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t en
             }
         }
         b[0] = bx, b[1] = by, b[2] = bz;
-        wc_sym3_inverse(diag, pre);
+        wci_sym3_inverse(diag, pre);
     }
     return 0;
 }
@@ -388,7 +388,7 @@ static int apply_range(void *context, int64_t first, int64_t last)
 
 /* z = the preconditioner times r: the block-Jacobi step, plus on a large
  * cloth the coarse levels' correction of each free particle's aggregate
- * (solved before this pass: wc_multigrid_coarse_solve). Sums r . z. One
+ * (solved before this pass: wci_multigrid_coarse_solve). Sums r . z. One
  * pass for the three, so that r and z are read once per iteration. */
 static int precondition_range(void *context, int64_t first, int64_t last)
 {
@@ -515,14 +515,14 @@ static double precondition(implicit_pass *pass, const wc_team *team, int first,
 {
     wc_implicit_state *s = pass->state;
     if (s->multigrid) {
-        wc_multigrid_coarse_solve_team(s->multigrid, r_old, q, alpha, team);
-        wc_team_barrier(team);
-        pass->coarse = wc_multigrid_coarse_solution(s->multigrid);
-        pass->aggregate = wc_multigrid_fine_aggregates(s->multigrid);
+        wci_multigrid_coarse_solve_team(s->multigrid, r_old, q, alpha, team);
+        wci_team_barrier(team);
+        pass->coarse = wci_multigrid_coarse_solution(s->multigrid);
+        pass->aggregate = wci_multigrid_fine_aggregates(s->multigrid);
     }
     team_blocks(pass, team, precondition_range, PARTIAL_RZ);
     if (first) team_blocks(pass, team, first_direction_range, PARTIAL_RZ);
-    wc_team_barrier(team);
+    wci_team_barrier(team);
     return set_sum(s, PARTIAL_RZ);
 }
 
@@ -565,7 +565,7 @@ static void solve_body(void *context, const wc_team *team)
     wc_implicit_state *s = pass.state;
     pass.r = s->r, pass.r_next = s->r_next;
     team_blocks(&pass, team, start_range, PARTIAL_RR);
-    wc_team_barrier(team);
+    wci_team_barrier(team);
     double bb = set_sum(s, PARTIAL_RR), rr = bb, bound = shared->bound;
     int32_t it = 0;
     if (bb > 0.0) {
@@ -578,9 +578,9 @@ static void solve_body(void *context, const wc_team *team)
             if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
                 break;
             if (link_begin < link_end) link_products_range(&pass, link_begin, link_end);
-            wc_team_barrier(team);
+            wci_team_barrier(team);
             team_blocks(&pass, team, apply_range, PARTIAL_PQ);
-            wc_team_barrier(team);
+            wci_team_barrier(team);
             double pq = set_sum(s, PARTIAL_PQ);
             /* A is positive definite, so pq > 0 unless p = 0 or something
              * is not finite: then stop, the caller checks the result */
@@ -595,7 +595,7 @@ static void solve_body(void *context, const wc_team *team)
             rr = set_sum(s, PARTIAL_RR);
             pass.factor = rz_next / rz;
             team_blocks(&pass, team, update_direction_range, PARTIAL_RR);
-            wc_team_barrier(team);
+            wci_team_barrier(team);
             rz = rz_next;
         }
     }
@@ -622,7 +622,7 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
                        ? velocity_tolerance * velocity_tolerance * free_mass(pass)
                        : 0.0;
     solve_pass shared = {pass, bound};
-    wc_parallel_team(wc_threads_for(pass->state->links, threads), solve_body, &shared);
+    wci_parallel_team(wc_threads_for(pass->state->links, threads), solve_body, &shared);
 }
 
 /* First particle whose right-hand side is not finite, -1 if none. Forces
@@ -654,7 +654,7 @@ static int positions_range(void *context, int64_t begin, int64_t end)
     for (int64_t i = begin; i < end; ++i) {
         if (c->pin_slot[i] >= 0) {
             double p[3];
-            wc_pinned_position(c, c->pin_slot[i], pass->pin_fraction, p);
+            wci_pinned_position(c, c->pin_slot[i], pass->pin_fraction, p);
             c->nx[i] = p[0], c->ny[i] = p[1], c->nz[i] = p[2];
             continue;
         }
@@ -666,7 +666,7 @@ static int positions_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, double tolerance,
+int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, double tolerance,
                               int threads)
 {
     WC_ASSERT(c->implicit != NULL);
@@ -687,15 +687,15 @@ int32_t wc_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doubl
     double h_prev = c->has_history ? c->dt_prev : 0.0;
     implicit_pass pass = {c, s, dt, pin_fraction, (dt + h_prev) / (2.0 * dt),
                           NULL, NULL, 0.0, NULL, NULL, NULL, NULL, NULL};
-    wc_parallel_for(n, particle_threads, start_velocities_range, &pass);
-    wc_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
-    wc_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);
+    wci_parallel_for(n, particle_threads, start_velocities_range, &pass);
+    wci_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
+    wci_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);
     int32_t bad = first_non_finite_rhs(s);
     if (bad >= 0) return bad;
     if (s->multigrid)
-        wc_multigrid_update(s->multigrid, s->mass_diag, s->block, c->pin_slot, threads);
+        wci_multigrid_update(s->multigrid, s->mass_diag, s->block, c->pin_slot, threads);
     solve(&pass, tolerance * dt, threads);
     positions_pass positions = {c, s, dt, pin_fraction, pass.share};
-    wc_parallel_for(n, particle_threads, positions_range, &positions);
-    return wc_first_non_finite_xyz(c->nx, c->ny, c->nz, n);
+    wci_parallel_for(n, particle_threads, positions_range, &positions);
+    return wci_first_non_finite_xyz(c->nx, c->ny, c->nz, n);
 }

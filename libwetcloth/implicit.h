@@ -19,14 +19,14 @@
 typedef struct wc_implicit_state wc_implicit_state;
 
 /// Buffers for a cloth's solve. NULL when out of memory.
-wc_implicit_state *wc_implicit_state_create(const wc_cloth *cloth);
+wc_implicit_state *wci_implicit_state_create(const wc_cloth *cloth);
 
-void wc_implicit_state_destroy(wc_implicit_state *state);
+void wci_implicit_state_destroy(wc_implicit_state *state);
 
 /// Conjugate-gradient iterations of the last solve, and its residual
 /// relative to the right-hand side.
-int32_t wc_implicit_last_iterations(const wc_implicit_state *state);
-double wc_implicit_last_residual(const wc_implicit_state *state);
+int32_t wci_implicit_last_iterations(const wc_implicit_state *state);
+double wci_implicit_last_residual(const wc_implicit_state *state);
 
 /// Writes the positions after a step of dt into cloth->nx/ny/nz, x + dt (v
 /// + share dv), with v the last step's chord velocity, dv from the solve
@@ -39,7 +39,7 @@ double wc_implicit_last_residual(const wc_implicit_state *state);
 /// m/s^2; 0: to round-off). Returns the index of the first particle whose
 /// new position is not finite, or -1 when all are. cloth->implicit must exist
 /// (asserted).
-int32_t wc_integrate_implicit(wc_cloth *cloth, double dt, double pin_fraction, double tolerance,
+int32_t wci_integrate_implicit(wc_cloth *cloth, double dt, double pin_fraction, double tolerance,
                               int threads);
 
 #endif

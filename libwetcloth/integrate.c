@@ -5,13 +5,13 @@
 #include "parallel.h"
 #include "primitives.h"
 
-void wc_pinned_position(const wc_cloth *c, int32_t slot, double fraction, double out[3])
+void wci_pinned_position(const wc_cloth *c, int32_t slot, double fraction, double out[3])
 {
     const double *from = c->pins.from + 3 * (size_t)slot, *to = c->pins.to + 3 * (size_t)slot;
     for (int k = 0; k < 3; ++k) out[k] = fraction == 1.0 ? to[k] : wc_lerp(from[k], to[k], fraction);
 }
 
-/* One Verlet step's constants (see wc_integrate_verlet). */
+/* One Verlet step's constants (see wci_integrate_verlet). */
 typedef struct verlet_pass {
     wc_cloth *cloth;
     double pin_fraction, ratio, acc_scale;
@@ -28,7 +28,7 @@ static int verlet_range(void *context, int64_t begin, int64_t end)
     for (int64_t i = begin; i < end; ++i) {
         double p[3];
         if (c->pin_slot[i] >= 0) {
-            wc_pinned_position(c, c->pin_slot[i], v->pin_fraction, p);
+            wci_pinned_position(c, c->pin_slot[i], v->pin_fraction, p);
         } else {
             double s = c->inv_mass[i] * acc_scale;
             double mx = first ? c->px[i] : c->x[i] - c->px[i];
@@ -44,7 +44,7 @@ static int verlet_range(void *context, int64_t begin, int64_t end)
     return bad;
 }
 
-int32_t wc_integrate_verlet(wc_cloth *c, double dt, double pin_fraction, int threads)
+int32_t wci_integrate_verlet(wc_cloth *c, double dt, double pin_fraction, int threads)
 {
     int32_t n = c->particle_count;
     int first = !c->has_history;
@@ -56,11 +56,11 @@ int32_t wc_integrate_verlet(wc_cloth *c, double dt, double pin_fraction, int thr
      * starts from the velocity v held in px: x + v dt + a dt^2 / 2. */
     verlet_pass pass = {c, pin_fraction, first ? dt : dt / c->dt_prev,
                         first ? 0.5 * dt * dt : 0.5 * dt * (dt + c->dt_prev), first};
-    if (!wc_parallel_for(n, wc_threads_for(n, threads), verlet_range, &pass)) return -1;
-    return wc_first_non_finite_xyz(c->nx, c->ny, c->nz, n);
+    if (!wci_parallel_for(n, wc_threads_for(n, threads), verlet_range, &pass)) return -1;
+    return wci_first_non_finite_xyz(c->nx, c->ny, c->nz, n);
 }
 
-int32_t wc_first_non_finite_xyz(const double *x, const double *y, const double *z, int32_t n)
+int32_t wci_first_non_finite_xyz(const double *x, const double *y, const double *z, int32_t n)
 {
     for (int32_t i = 0; i < n; ++i)
         if (!(isfinite(x[i]) && isfinite(y[i]) && isfinite(z[i]))) return i;

@@ -9,13 +9,13 @@
 /// forces in cloth->fx/fy/fz. Pinned particles go to from + (to - from) *
 /// pin_fraction. Returns the index of the first particle whose new position
 /// is not finite, or -1 when all are.
-int32_t wc_integrate_verlet(wc_cloth *cloth, double dt, double pin_fraction, int threads);
+int32_t wci_integrate_verlet(wc_cloth *cloth, double dt, double pin_fraction, int threads);
 
 /// Where pin `slot` is at `fraction` of the way from its start to its
 /// target (exactly the target at fraction 1).
-void wc_pinned_position(const wc_cloth *cloth, int32_t slot, double fraction, double out[3]);
+void wci_pinned_position(const wc_cloth *cloth, int32_t slot, double fraction, double out[3]);
 
 /// Index of the first particle with a non-finite coordinate, or -1.
-int32_t wc_first_non_finite_xyz(const double *x, const double *y, const double *z, int32_t n);
+int32_t wci_first_non_finite_xyz(const double *x, const double *y, const double *z, int32_t n);
 
 #endif

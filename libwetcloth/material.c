@@ -38,12 +38,12 @@ static wc_status check_range(wc_message *msg, const char *field, double value, d
     snprintf(a, sizeof a, "%g", value);
     snprintf(b, sizeof b, "%g", bound);
     int digits = strcmp(a, b) == 0 ? 17 : 6;
-    return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+    return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                    "material.%s must be in %s%g, %g] but is %.*g", field, lo_open ? "(" : "[",
                    lo, hi, digits, value);
 }
 
-wc_status wc_material_validate(const wc_material *m, wc_message *msg)
+wc_status wci_material_validate(const wc_material *m, wc_message *msg)
 {
     wc_status s;
     if ((s = check_range(msg, "density", m->density, 0.0, 1e3, 1))) return s;

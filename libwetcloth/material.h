@@ -4,6 +4,6 @@
 #include "wetcloth.h"
 
 /// Checks every field against its documented range; names the first bad one.
-wc_status wc_material_validate(const wc_material *material, wc_message *msg);
+wc_status wci_material_validate(const wc_material *material, wc_message *msg);
 
 #endif

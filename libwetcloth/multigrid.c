@@ -54,21 +54,21 @@ struct wc_multigrid {
 
 static void level_free(level *l)
 {
-    for (int k = 0; k < 4; ++k) wc_free(l->own_ints[k]);
+    for (int k = 0; k < 4; ++k) wci_free(l->own_ints[k]);
     int32_t *ints[] = {l->agg, l->member_start, l->members, l->fine_start, l->fine_links};
-    for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) wc_free(ints[k]);
+    for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) wci_free(ints[k]);
     double *doubles[] = {l->diag, l->own_block, l->inv, l->x, l->b, l->r, l->post};
-    for (size_t k = 0; k < sizeof doubles / sizeof doubles[0]; ++k) wc_free(doubles[k]);
+    for (size_t k = 0; k < sizeof doubles / sizeof doubles[0]; ++k) wci_free(doubles[k]);
 }
 
-void wc_multigrid_destroy(wc_multigrid *mg)
+void wci_multigrid_destroy(wc_multigrid *mg)
 {
     if (!mg) return;
     for (int32_t k = 0; k < mg->levels; ++k) level_free(&mg->level[k]);
-    wc_free(mg);
+    wci_free(mg);
 }
 
-int32_t wc_multigrid_levels(const wc_multigrid *mg) { return mg->levels; }
+int32_t wci_multigrid_levels(const wc_multigrid *mg) { return mg->levels; }
 
 /* ------------------------------------------------------------------------ */
 /* Structure, once per cloth                                                */
@@ -129,9 +129,9 @@ static int32_t aggregate(const level *l, int32_t neighbour_links, int32_t *agg)
 /* Each aggregate's nodes, ascending (a counting sort). */
 static int build_members(level *f, int32_t nc)
 {
-    f->member_start = wc_alloc_array((size_t)nc + 1, sizeof(int32_t));
-    f->members = wc_alloc_array((size_t)f->n, sizeof(int32_t));
-    int32_t *fill = wc_alloc_array((size_t)nc, sizeof(int32_t));
+    f->member_start = wci_alloc_array((size_t)nc + 1, sizeof(int32_t));
+    f->members = wci_alloc_array((size_t)f->n, sizeof(int32_t));
+    int32_t *fill = wci_alloc_array((size_t)nc, sizeof(int32_t));
     int failed = !f->member_start || !f->members || !fill;
     if (!failed) {
         for (int32_t i = 0; i < f->n; ++i) ++f->member_start[f->agg[i] + 1];
@@ -139,7 +139,7 @@ static int build_members(level *f, int32_t nc)
         for (int32_t i = 0; i < f->n; ++i)
             f->members[f->member_start[f->agg[i]] + fill[f->agg[i]]++] = i;
     }
-    wc_free(fill);
+    wci_free(fill);
     return failed;
 }
 
@@ -164,7 +164,7 @@ static cross_link *sorted_cross_links(const level *f, int32_t *count)
 {
     int32_t m = 0;
     for (int32_t e = 0; e < f->links; ++e) m += f->agg[f->end_a[e]] != f->agg[f->end_b[e]];
-    cross_link *cross = wc_alloc_array((size_t)m + 1, sizeof *cross);
+    cross_link *cross = wci_alloc_array((size_t)m + 1, sizeof *cross);
     if (!cross) return NULL;
     m = 0;
     for (int32_t e = 0; e < f->links; ++e) {
@@ -191,10 +191,10 @@ static int build_coarse_links(level *f, level *c)
     cross_link *cross = sorted_cross_links(f, &m);
     if (!cross) return 1;
     for (int32_t k = 0; k < m; ++k) links += new_pair(cross, k);
-    int32_t *end_a = c->own_ints[0] = wc_alloc_array((size_t)links + 1, sizeof(int32_t));
-    int32_t *end_b = c->own_ints[1] = wc_alloc_array((size_t)links + 1, sizeof(int32_t));
-    f->fine_start = wc_alloc_array((size_t)links + 1, sizeof(int32_t));
-    f->fine_links = wc_alloc_array((size_t)m + 1, sizeof(int32_t));
+    int32_t *end_a = c->own_ints[0] = wci_alloc_array((size_t)links + 1, sizeof(int32_t));
+    int32_t *end_b = c->own_ints[1] = wci_alloc_array((size_t)links + 1, sizeof(int32_t));
+    f->fine_start = wci_alloc_array((size_t)links + 1, sizeof(int32_t));
+    f->fine_links = wci_alloc_array((size_t)m + 1, sizeof(int32_t));
     int failed = !end_a || !end_b || !f->fine_start || !f->fine_links;
     if (!failed) {
         int32_t e = -1;
@@ -208,7 +208,7 @@ static int build_coarse_links(level *f, level *c)
         f->fine_start[links] = m;
         c->links = links, c->end_a = end_a, c->end_b = end_b;
     }
-    wc_free(cross);
+    wci_free(cross);
     return failed;
 }
 
@@ -216,9 +216,9 @@ static int build_coarse_links(level *f, level *c)
  * the first end, ~k for the second. */
 static int build_coarse_adjacency(level *c)
 {
-    int32_t *start = c->own_ints[2] = wc_alloc_array((size_t)c->n + 1, sizeof(int32_t));
-    int32_t *adj = c->own_ints[3] = wc_alloc_array(2 * (size_t)c->links + 1, sizeof(int32_t));
-    int32_t *fill = wc_alloc_array((size_t)c->n + 1, sizeof(int32_t));
+    int32_t *start = c->own_ints[2] = wci_alloc_array((size_t)c->n + 1, sizeof(int32_t));
+    int32_t *adj = c->own_ints[3] = wci_alloc_array(2 * (size_t)c->links + 1, sizeof(int32_t));
+    int32_t *fill = wci_alloc_array((size_t)c->n + 1, sizeof(int32_t));
     int failed = !start || !adj || !fill;
     if (!failed) {
         for (int32_t k = 0; k < c->links; ++k) ++start[c->end_a[k] + 1], ++start[c->end_b[k] + 1];
@@ -229,21 +229,21 @@ static int build_coarse_adjacency(level *c)
         }
         c->adj_start = start, c->adj = adj;
     }
-    wc_free(fill);
+    wci_free(fill);
     return failed;
 }
 
 static int allocate_values(level *c)
 {
     size_t n = (size_t)c->n;
-    c->diag = wc_alloc_array(6 * n, sizeof(double));
-    c->inv = wc_alloc_array(6 * n, sizeof(double));
-    c->own_block = wc_alloc_array(6 * (size_t)c->links + 1, sizeof(double));
+    c->diag = wci_alloc_array(6 * n, sizeof(double));
+    c->inv = wci_alloc_array(6 * n, sizeof(double));
+    c->own_block = wci_alloc_array(6 * (size_t)c->links + 1, sizeof(double));
     c->block = c->own_block;
-    c->x = wc_alloc_array(3 * n, sizeof(double));
-    c->b = wc_alloc_array(3 * n, sizeof(double));
-    c->r = wc_alloc_array(3 * n, sizeof(double));
-    c->post = wc_alloc_array(3 * n, sizeof(double));
+    c->x = wci_alloc_array(3 * n, sizeof(double));
+    c->b = wci_alloc_array(3 * n, sizeof(double));
+    c->r = wci_alloc_array(3 * n, sizeof(double));
+    c->post = wci_alloc_array(3 * n, sizeof(double));
     return !c->diag || !c->inv || !c->own_block || !c->x || !c->b || !c->r || !c->post;
 }
 
@@ -254,11 +254,11 @@ static int coarsen(wc_multigrid *mg, int32_t neighbour_links, int *added)
     level *f = &mg->level[mg->levels - 1];
     *added = 0;
     if (f->n <= COARSEST_NODES || mg->levels == MAX_LEVELS) return 0;
-    f->agg = wc_alloc_array((size_t)f->n, sizeof(int32_t));
+    f->agg = wci_alloc_array((size_t)f->n, sizeof(int32_t));
     if (!f->agg) return 1;
     int32_t nc = aggregate(f, neighbour_links, f->agg);
     if (nc > LEAST_REDUCTION * f->n) {
-        wc_free(f->agg);
+        wci_free(f->agg);
         f->agg = NULL;
         return 0;
     }
@@ -269,13 +269,13 @@ static int coarsen(wc_multigrid *mg, int32_t neighbour_links, int *added)
            allocate_values(c);
 }
 
-int wc_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const int32_t *end_b,
+int wci_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const int32_t *end_b,
                         int32_t neighbour_links, const int32_t *adj_start, const int32_t *adj,
                         wc_multigrid **out)
 {
     *out = NULL;
     if (n < WC_MULTIGRID_MIN_PARTICLES) return 0;
-    wc_multigrid *mg = wc_alloc_array(1, sizeof *mg);
+    wc_multigrid *mg = wci_alloc_array(1, sizeof *mg);
     if (!mg) return 1;
     level *fine = &mg->level[0];
     fine->n = n, fine->links = links, fine->end_a = end_a, fine->end_b = end_b;
@@ -288,7 +288,7 @@ int wc_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const in
         neighbour_links = mg->level[mg->levels - 1].links;
     }
     if (failed || mg->levels == 1) {
-        wc_multigrid_destroy(mg);
+        wci_multigrid_destroy(mg);
         return failed;
     }
     *out = mg;
@@ -365,12 +365,12 @@ static int coarse_nodes_range(void *context, int64_t begin, int64_t end)
         memcpy(whole, d, sizeof whole);
         for (int32_t k = c->adj_start[a]; k < c->adj_start[a + 1]; ++k)
             add_block(whole, c->block + 6 * (size_t)link_of(c->adj[k]));
-        wc_sym3_inverse(whole, c->inv + 6 * (size_t)a);
+        wci_sym3_inverse(whole, c->inv + 6 * (size_t)a);
     }
     return 0;
 }
 
-void wc_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
+void wci_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
                          const int32_t *pin_slot, int threads)
 {
     level *fine = &mg->level[0];
@@ -378,8 +378,8 @@ void wc_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double
     for (int32_t k = 0; k + 1 < mg->levels; ++k) {
         mg_pass p = {&mg->level[k], &mg->level[k + 1], NULL, NULL, NULL, 0.0};
         int32_t links = p.coarse->links, nodes = p.coarse->n;
-        wc_parallel_for(links, wc_threads_for(links, threads), coarse_links_range, &p);
-        wc_parallel_for(nodes, wc_threads_for(nodes, threads), coarse_nodes_range, &p);
+        wci_parallel_for(links, wc_threads_for(links, threads), coarse_links_range, &p);
+        wci_parallel_for(nodes, wc_threads_for(nodes, threads), coarse_nodes_range, &p);
     }
 }
 
@@ -551,7 +551,7 @@ static void team_loop(const wc_team *team, int split, wc_range_fn body, level *l
  * first thread alone. */
 static void sync_loops(const wc_team *team, int split_before, int split_after)
 {
-    if (split_before || split_after) wc_team_barrier(team);
+    if (split_before || split_after) wci_team_barrier(team);
 }
 
 /* One smoothing sweep after the first: the residual, then the sweep from
@@ -595,7 +595,7 @@ static void cycle(wc_multigrid *mg, int32_t k, const double *in, const double *m
     team_loop(team, split, correct_smooth_range, l, c, cycle_solution(mg, k + 1), l->post, l->n);
 }
 
-void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
+void wci_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
                                     double alpha, const wc_team *team)
 {
     cycle(mg, 1, r, q, alpha, team);
@@ -609,39 +609,39 @@ typedef struct coarse_solve_pass {
 static void coarse_solve_body(void *context, const wc_team *team)
 {
     const coarse_solve_pass *p = context;
-    wc_multigrid_coarse_solve_team(p->mg, p->r, NULL, 0.0, team);
+    wci_multigrid_coarse_solve_team(p->mg, p->r, NULL, 0.0, team);
 }
 
-void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads)
+void wci_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads)
 {
     coarse_solve_pass p = {mg, r};
-    wc_parallel_team(threads, coarse_solve_body, &p);
+    wci_parallel_team(threads, coarse_solve_body, &p);
 }
 
-const double *wc_multigrid_coarse_solution(const wc_multigrid *mg)
+const double *wci_multigrid_coarse_solution(const wc_multigrid *mg)
 {
     return cycle_solution(mg, 1);
 }
 
-const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg) { return mg->level[0].agg; }
+const int32_t *wci_multigrid_fine_aggregates(const wc_multigrid *mg) { return mg->level[0].agg; }
 
-void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
+void wci_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
 {
-    wc_multigrid_coarse_solve(mg, r, threads);
+    wci_multigrid_coarse_solve(mg, r, threads);
     mg_pass p = {&mg->level[0], &mg->level[1], cycle_solution(mg, 1), z, NULL, 0.0};
-    wc_parallel_for(mg->level[0].n, mg->level[0].n >= LEVEL_PARALLEL_MIN ? threads : 1,
+    wci_parallel_for(mg->level[0].n, mg->level[0].n >= LEVEL_PARALLEL_MIN ? threads : 1,
                     prolong_range, &p);
 }
 
-int32_t wc_multigrid_level_size(const wc_multigrid *mg, int32_t k) { return mg->level[k].n; }
+int32_t wci_multigrid_level_size(const wc_multigrid *mg, int32_t k) { return mg->level[k].n; }
 
-int32_t wc_multigrid_aggregate(const wc_multigrid *mg, int32_t k, int32_t node)
+int32_t wci_multigrid_aggregate(const wc_multigrid *mg, int32_t k, int32_t node)
 {
     return mg->level[k].agg[node];
 }
 
 /* With b = 0 the residual is -A x. */
-void wc_multigrid_level_product(wc_multigrid *mg, int32_t k, const double *in, double *out)
+void wci_multigrid_level_product(wc_multigrid *mg, int32_t k, const double *in, double *out)
 {
     level *l = &mg->level[k];
     size_t len = 3 * (size_t)l->n;

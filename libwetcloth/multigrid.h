@@ -54,47 +54,47 @@ typedef struct wc_multigrid wc_multigrid;
 /// and would make aggregates too large). The arrays are borrowed and must
 /// outlive the result. Sets *out to NULL when the cloth is too small to
 /// coarsen (or does not shrink); returns 1 when out of memory, else 0.
-int wc_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const int32_t *end_b,
+int wci_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const int32_t *end_b,
                         int32_t neighbour_links, const int32_t *adj_start, const int32_t *adj,
                         wc_multigrid **out);
-void wc_multigrid_destroy(wc_multigrid *mg);
+void wci_multigrid_destroy(wc_multigrid *mg);
 
 /// Levels including the finest.
-int32_t wc_multigrid_levels(const wc_multigrid *mg);
+int32_t wci_multigrid_levels(const wc_multigrid *mg);
 
 /// The step's matrix: per particle the mass with drag (`mass_diag`, a
 /// multiple of the identity), per link its block (6 values: xx, xy, xz, yy,
 /// yz, zz), and the pins (`pin_slot` >= 0: pinned; their rows and columns
 /// are removed). The arrays are borrowed until the next update.
-void wc_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
+void wci_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
                          const int32_t *pin_slot, int threads);
 
 /// z += P C P^T r, the coarse levels' part of the preconditioner; r is
 /// zero at pins and z is left unchanged there.
-void wc_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads);
+void wci_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads);
 
 /// The same in two halves, for a caller that adds the correction in a pass
 /// of its own over the fine nodes (implicit.c, with its block-Jacobi step
 /// and a dot product): C P^T r, 3 values per aggregate of the finest
 /// level, valid until the next call; a free fine node i adds entry
 /// aggregates[i] of it (P), a pinned node nothing.
-void wc_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads);
-/// The same on a team already running (wc_parallel_team), every thread
+void wci_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads);
+/// The same on a team already running (wci_parallel_team), every thread
 /// calling it, for the residual r - alpha q (q NULL: r), computed where it
 /// is read as (r - alpha * q) is: r and q must be complete on entry (a
 /// barrier after the loops that wrote them), and the solution is complete
-/// after the caller's next wc_team_barrier. So a caller can update r out
+/// after the caller's next wci_team_barrier. So a caller can update r out
 /// of place in the same phase.
-void wc_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
+void wci_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
                                     double alpha, const wc_team *team);
-const double *wc_multigrid_coarse_solution(const wc_multigrid *mg);
-const int32_t *wc_multigrid_fine_aggregates(const wc_multigrid *mg);
+const double *wci_multigrid_coarse_solution(const wc_multigrid *mg);
+const int32_t *wci_multigrid_fine_aggregates(const wc_multigrid *mg);
 
 /* For tests (tests/test_multigrid.c): a level's node count, the aggregate
  * (node of level + 1) of one of its nodes, and the product with a coarse
  * level's matrix, out = A in (level >= 1, after an update). */
-int32_t wc_multigrid_level_size(const wc_multigrid *mg, int32_t level);
-int32_t wc_multigrid_aggregate(const wc_multigrid *mg, int32_t level, int32_t node);
-void wc_multigrid_level_product(wc_multigrid *mg, int32_t level, const double *in, double *out);
+int32_t wci_multigrid_level_size(const wc_multigrid *mg, int32_t level);
+int32_t wci_multigrid_aggregate(const wc_multigrid *mg, int32_t level, int32_t node);
+void wci_multigrid_level_product(wc_multigrid *mg, int32_t level, const double *in, double *out);
 
 #endif

@@ -76,8 +76,8 @@ static void triangle_motion(const wc_collider *c, int32_t t, double t0[3][3], do
         memcpy(n1, n0, 3 * sizeof *n1);
         return;
     }
-    wc_triangle_normal(t0[0], t0[1], t0[2], n0);
-    wc_triangle_normal(t1[0], t1[1], t1[2], n1);
+    wci_triangle_normal(t0[0], t0[1], t0[2], n0);
+    wci_triangle_normal(t1[0], t1[1], t1[2], n1);
 }
 
 /* Which side of a triangle the particle belongs on: the side it was on at
@@ -105,7 +105,7 @@ static int crosses_static(const double start[3], const double end[3], double t0[
     if (ds * de > 0.0 || (ds == 0.0 && de == 0.0)) return 0;
     double f = ds / (ds - de), cross[3];
     for (int k = 0; k < 3; ++k) cross[k] = start[k] + (end[k] - start[k]) * f;
-    return wc_point_triangle_closest(cross, t0[0], t0[1], t0[2], w) <= r * r;
+    return wci_point_triangle_closest(cross, t0[0], t0[1], t0[2], w) <= r * r;
 }
 
 /* The record of a particle touching the surface point `surface` (end of
@@ -129,7 +129,7 @@ static void surface_contact(int32_t particle, const double end[3], const double 
     }
 }
 
-int wc_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particle,
+int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particle,
                                 const double start[3], const double end[3], double r,
                                 wc_contact *out)
 {
@@ -147,7 +147,7 @@ int wc_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particl
     triangle_motion(c, t, t0, t1, n0, n1);
     if (n1[0] == 0.0 && n1[1] == 0.0 && n1[2] == 0.0) return 0;
     double w[3], cp[3], offset[3], tc;
-    double d2 = wc_point_triangle_closest(end, t1[0], t1[1], t1[2], w);
+    double d2 = wci_point_triangle_closest(end, t1[0], t1[1], t1[2], w);
     bary_point(t1[0], t1[1], t1[2], w, cp);
     for (int k = 0; k < 3; ++k) offset[k] = end[k] - cp[k];
     double side = side_of(start, t0[0], n0, offset, n1);
@@ -158,7 +158,7 @@ int wc_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particl
      * contact is placed where the particle met the triangle, on the
      * end-of-step triangle. */
     if (!hit) {
-        hit = c->moving ? wc_ccd_point_triangle(start, end, t0[0], t1[0], t0[1], t1[1], t0[2],
+        hit = c->moving ? wci_ccd_point_triangle(start, end, t0[0], t1[0], t0[1], t1[1], t0[2],
                                                 t1[2], r, &tc, w)
                         : crosses_static(start, end, t0, n0, r, w);
         if (hit) {
@@ -182,7 +182,7 @@ int wc_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particl
     return 1;
 }
 
-int wc_narrow_particle_convex(const wc_collider *c, int32_t particle, const double start[3],
+int wci_narrow_particle_convex(const wc_collider *c, int32_t particle, const double start[3],
                               const double end[3], double r, wc_contact *out)
 {
     for (int k = 0; k < 3; ++k) {
@@ -193,14 +193,14 @@ int wc_narrow_particle_convex(const wc_collider *c, int32_t particle, const doub
      * frame (start in the pose at the start of the step, end in the pose at
      * its end), where the shape stands still. */
     double a[3], b[3], local[3], n_local[3], surface[3], n[3], before[3], motion[3];
-    wc_pose_to_local(&c->pose_current, start, a);
-    wc_pose_to_local(&c->pose_next, end, b);
-    if (!wc_convex_resolve(&c->convex, a, b, r, local, n_local)) return 0;
-    wc_pose_rotate(&c->pose_next, n_local, n);
+    wci_pose_to_local(&c->pose_current, start, a);
+    wci_pose_to_local(&c->pose_next, end, b);
+    if (!wci_convex_resolve(&c->convex, a, b, r, local, n_local)) return 0;
+    wci_pose_rotate(&c->pose_next, n_local, n);
     /* the surface point under the particle, at the end and the start */
     for (int k = 0; k < 3; ++k) local[k] -= n_local[k] * r;
-    wc_pose_to_world(&c->pose_next, local, surface);
-    wc_pose_to_world(&c->pose_current, local, before);
+    wci_pose_to_world(&c->pose_next, local, surface);
+    wci_pose_to_world(&c->pose_current, local, before);
     for (int k = 0; k < 3; ++k) motion[k] = surface[k] - before[k];
     surface_contact(particle, end, surface, n, motion, r, out);
     return 1;
@@ -210,7 +210,7 @@ int wc_narrow_particle_convex(const wc_collider *c, int32_t particle, const doub
 /* Collider vertices and edges against cloth triangles and edges            */
 /* ------------------------------------------------------------------------ */
 
-int wc_narrow_needs_ccd(double motion, double r) { return 2.0 * motion > r; }
+int wci_narrow_needs_ccd(double motion, double r) { return 2.0 * motion > r; }
 
 /* Points along the step at which turning_cross follows a normal. */
 #define NORMAL_SAMPLES 8
@@ -268,7 +268,7 @@ static int element_contact(const int32_t *idx, const double *w, int count, const
     return 1;
 }
 
-int wc_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t idx[3], const wc_collider *col,
+int wci_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t idx[3], const wc_collider *col,
                               int32_t vertex, int ccd, double r, double *d2, wc_contact *out)
 {
     double v0[3], v1[3], a0[3], b0[3], c0[3], a1[3], b1[3], c1[3], w[3], p1[3], p0[3], n1[3], n0[3], tc;
@@ -276,9 +276,9 @@ int wc_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t idx[3],
     vertex_of(col->next, vertex, v1);
     start_of(p, idx[0], a0), start_of(p, idx[1], b0), start_of(p, idx[2], c0);
     end_of(p, idx[0], a1), end_of(p, idx[1], b1), end_of(p, idx[2], c1);
-    *d2 = wc_point_triangle_closest(v1, a1, b1, c1, w);
+    *d2 = wci_point_triangle_closest(v1, a1, b1, c1, w);
     int hit = *d2 < r * r * (1.0 - WC_FEATURE_SLACK);
-    if (!hit && ccd) hit = wc_ccd_point_triangle(v0, v1, a0, a1, b0, b1, c0, c1, 1e-9 * r, &tc, w);
+    if (!hit && ccd) hit = wci_ccd_point_triangle(v0, v1, a0, a1, b0, b1, c0, c1, 1e-9 * r, &tc, w);
     if (!hit) return 0;
     double ab0[3], ac0[3], ab1[3], ac1[3];
     for (int d = 0; d < 3; ++d) {
@@ -326,7 +326,7 @@ static int edge_push_normal(const double p0[3], const double p1[3], const double
      * sphere). */
     double gap = sqrt(dot3(end_gap, end_gap)), t, sp, u;
     if (ccd && !crossed && gap > 1e-3 * r &&
-        !wc_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &t, &sp, &u)) {
+        !wci_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &t, &sp, &u)) {
         for (int d = 0; d < 3; ++d) n[d] = end_gap[d] / gap;
         return 1;
     }
@@ -344,7 +344,7 @@ static int edge_push_normal(const double p0[3], const double p1[3], const double
     return 1;
 }
 
-int wc_narrow_edge_edge(const wc_particle_arrays *p, const int32_t idx[2], const wc_collider *col,
+int wci_narrow_edge_edge(const wc_particle_arrays *p, const int32_t idx[2], const wc_collider *col,
                         int32_t f, int ccd, double r, double *d2, wc_contact *out)
 {
     double p0[3], p1[3], q0[3], q1[3], a0[3], b0[3], a1[3], b1[3], sp, u, tc;
@@ -354,10 +354,10 @@ int wc_narrow_edge_edge(const wc_particle_arrays *p, const int32_t idx[2], const
     vertex_of(col->next, col->edges[2 * (size_t)f + 1], q1);
     start_of(p, idx[0], a0), start_of(p, idx[1], b0);
     end_of(p, idx[0], a1), end_of(p, idx[1], b1);
-    *d2 = wc_segment_segment_closest(p1, q1, a1, b1, &sp, &u);
+    *d2 = wci_segment_segment_closest(p1, q1, a1, b1, &sp, &u);
     int hit = *d2 < r * r * (1.0 - WC_FEATURE_SLACK), crossed = 0;
     if (!hit && ccd)
-        hit = crossed = wc_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &tc, &sp, &u);
+        hit = crossed = wci_ccd_edge_edge(p0, p1, q0, q1, a0, a1, b0, b1, 1e-9 * r, &tc, &sp, &u);
     if (!hit) return 0;
     /* A contact at an end of either edge is a vertex's business (a cloth
      * particle against a face, or a collider vertex against a triangle). */

@@ -35,12 +35,12 @@
 /// collider at contact distance r. Returns 1 and fills the record (source,
 /// count 1 with the particle index `particle`, normal, distance, target r,
 /// surface motion, place; friction left to the caller) on a touch.
-int wc_narrow_particle_triangle(const wc_collider *col, int32_t t, int32_t particle,
+int wci_narrow_particle_triangle(const wc_collider *col, int32_t t, int32_t particle,
                                 const double start[3], const double end[3], double r,
                                 wc_contact *out);
 
 /// The same against a convex collider.
-int wc_narrow_particle_convex(const wc_collider *col, int32_t particle, const double start[3],
+int wci_narrow_particle_convex(const wc_collider *col, int32_t particle, const double start[3],
                               const double end[3], double r, wc_contact *out);
 
 /// Whether a pair that moves relative to each other by up to `motion` (the
@@ -50,19 +50,19 @@ int wc_narrow_particle_convex(const wc_collider *col, int32_t particle, const do
 /// saw to it) and distance changes no faster than the points move, so with
 /// less relative motion than r a crossing still ends within r, where the
 /// proximity test sees it and takes the side from the start.
-int wc_narrow_needs_ccd(double motion, double r);
+int wci_narrow_needs_ccd(double motion, double r);
 
 /// Collider vertex v against cloth triangle `tri` (3 particle indices) of
 /// the particle arrays. *d2 gets the squared distance at the end of the step
 /// before any response. Returns 1 and fills the record on a touch deeper
 /// than the slack.
-int wc_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t tri[3],
+int wci_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t tri[3],
                               const wc_collider *col, int32_t v, int ccd, double r, double *d2,
                               wc_contact *out);
 
 /// Collider edge f against cloth edge `edge` (2 particle indices); as
-/// wc_narrow_vertex_triangle.
-int wc_narrow_edge_edge(const wc_particle_arrays *p, const int32_t edge[2], const wc_collider *col,
+/// wci_narrow_vertex_triangle.
+int wci_narrow_edge_edge(const wc_particle_arrays *p, const int32_t edge[2], const wc_collider *col,
                         int32_t f, int ccd, double r, double *d2, wc_contact *out);
 
 #endif

@@ -4,7 +4,7 @@
 #include <omp.h>
 #endif
 
-int wc_thread_count(int requested)
+int wci_thread_count(int requested)
 {
 #ifdef _OPENMP
     return requested > 0 ? requested : omp_get_max_threads();
@@ -14,7 +14,7 @@ int wc_thread_count(int requested)
 #endif
 }
 
-int wc_parallel_for(int64_t n, int threads, wc_range_fn body, void *context)
+int wci_parallel_for(int64_t n, int threads, wc_range_fn body, void *context)
 {
     if (n <= 0) return 0;
 #ifdef _OPENMP
@@ -34,7 +34,7 @@ int wc_parallel_for(int64_t n, int threads, wc_range_fn body, void *context)
     return body(context, 0, n) != 0;
 }
 
-void wc_parallel_team(int threads, wc_team_fn body, void *context)
+void wci_parallel_team(int threads, wc_team_fn body, void *context)
 {
 #ifdef _OPENMP
     if (threads > 1) {
@@ -52,7 +52,7 @@ void wc_parallel_team(int threads, wc_team_fn body, void *context)
     body(context, &team);
 }
 
-void wc_team_barrier(const wc_team *team)
+void wci_team_barrier(const wc_team *team)
 {
 #ifdef _OPENMP
     if (team->threads > 1) {

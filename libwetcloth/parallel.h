@@ -11,7 +11,7 @@
 #define WC_PARALLEL_MIN 4096
 
 /// Threads to use for a world's thread_count setting (0 = OpenMP default).
-int wc_thread_count(int requested);
+int wci_thread_count(int requested);
 
 /// Threads a loop of `work` iterations runs on: `threads` from
 /// WC_PARALLEL_MIN iterations up, one below.
@@ -21,7 +21,7 @@ static inline int wc_threads_for(int64_t work, int threads)
 }
 
 /// The body of a loop over the items [begin, end); returns nonzero to flag
-/// something (a non-finite value, say), which wc_parallel_for passes on.
+/// something (a non-finite value, say), which wci_parallel_for passes on.
 typedef int (*wc_range_fn)(void *context, int64_t begin, int64_t end);
 
 /// Runs body over the items [0, n): with threads > 1, in one contiguous
@@ -31,10 +31,10 @@ typedef int (*wc_range_fn)(void *context, int64_t begin, int64_t end);
 /// even when its if clause is false, and leaving it wakes the team with a
 /// futex system call: ~0.4 us per loop measured here, more than most loops
 /// of a 400-particle cloth cost, and a step runs several of them.
-int wc_parallel_for(int64_t n, int threads, wc_range_fn body, void *context);
+int wci_parallel_for(int64_t n, int threads, wc_range_fn body, void *context);
 
 /// One thread of a team that runs a whole sequence of loops in one parallel
-/// region (wc_parallel_team): its number, from 0, and the team's size.
+/// region (wci_parallel_team): its number, from 0, and the team's size.
 typedef struct wc_team {
     int thread, threads;
 } wc_team;
@@ -46,16 +46,16 @@ typedef void (*wc_team_fn)(void *context, const wc_team *team);
 /// Why: a solver iteration runs a dozen dependent loops, and a region per
 /// loop pays the team's wake-up and a join for each; a thread the scheduler
 /// takes away holds every one of them. In one region the loops are
-/// separated by barriers (wc_team_barrier), only where a loop reads what
+/// separated by barriers (wci_team_barrier), only where a loop reads what
 /// another thread wrote.
-void wc_parallel_team(int threads, wc_team_fn body, void *context);
+void wci_parallel_team(int threads, wc_team_fn body, void *context);
 
 /// Waits until every thread of the team has reached it; nothing for a
 /// team of one.
-void wc_team_barrier(const wc_team *team);
+void wci_team_barrier(const wc_team *team);
 
 /// This thread's part [*begin, *end) of the items [0, n): with `split`, the
-/// contiguous slice wc_parallel_for would give it; without, all of them on
+/// contiguous slice wci_parallel_for would give it; without, all of them on
 /// the team's first thread and none on the others.
 static inline void wc_team_slice(const wc_team *team, int64_t n, int split, int64_t *begin,
                                  int64_t *end)

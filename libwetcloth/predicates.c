@@ -164,7 +164,7 @@ static int orient3d_exact(const double a[3], const double b[3], const double c[3
     return sign_of(&det);
 }
 
-int wc_orient3d(const double a[3], const double b[3], const double c[3], const double d[3])
+int wci_orient3d(const double a[3], const double b[3], const double c[3], const double d[3])
 {
     double u[3], v[3], w[3];
     for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], v[k] = c[k] - a[k], w[k] = d[k] - a[k];
@@ -194,12 +194,12 @@ static int orient2d_exact(const double a[2], const double b[2], const double c[2
     return sign_of(&det);
 }
 
-int wc_orient2d(const double a[2], const double b[2], const double c[2])
+int wci_orient2d(const double a[2], const double b[2], const double c[2])
 {
     double l = (b[0] - a[0]) * (c[1] - a[1]), r = (b[1] - a[1]) * (c[0] - a[0]);
     double det = l - r, bound = ORIENT2D_BOUND * (fabs(l) + fabs(r));
     if (det > bound) return 1;
     if (det < -bound) return -1;
-    if (l == 0.0 && r == 0.0) return 0; /* as in wc_orient3d */
+    if (l == 0.0 && r == 0.0) return 0; /* as in wci_orient3d */
     return orient2d_exact(a, b, c);
 }

@@ -17,10 +17,10 @@
 
 /// Sign (-1, 0, +1) of det[b - a, c - a, d - a]: +1 when d lies on the side
 /// of the plane through a, b, c that (b - a) x (c - a) points to.
-int wc_orient3d(const double a[3], const double b[3], const double c[3], const double d[3]);
+int wci_orient3d(const double a[3], const double b[3], const double c[3], const double d[3]);
 
 /// Sign of det[b - a, c - a] for 2D points: +1 when a, b, c turn
 /// counter-clockwise.
-int wc_orient2d(const double a[2], const double b[2], const double c[2]);
+int wci_orient2d(const double a[2], const double b[2], const double c[2]);
 
 #endif

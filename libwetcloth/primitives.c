@@ -21,7 +21,7 @@ static void lerp(const double a[3], const double b[3], double t, double out[3])
     for (int k = 0; k < 3; ++k) out[k] = a[k] + (b[k] - a[k]) * t;
 }
 
-void wc_triangle_normal(const double a[3], const double b[3], const double c[3], double n[3])
+void wci_triangle_normal(const double a[3], const double b[3], const double c[3], double n[3])
 {
     double u[3], v[3];
     sub(b, a, u);
@@ -33,7 +33,7 @@ void wc_triangle_normal(const double a[3], const double b[3], const double c[3],
 
 /* Ericson, Real-Time Collision Detection, 5.1.5: Voronoi regions of the
  * triangle's vertices, edges and face, in that order. */
-double wc_point_triangle_closest(const double p[3], const double a[3], const double b[3],
+double wci_point_triangle_closest(const double p[3], const double a[3], const double b[3],
                                  const double c[3], double bary[3])
 {
     double ab[3], ac[3], ap[3], bp[3], cp[3], q[3];
@@ -77,7 +77,7 @@ double wc_point_triangle_closest(const double p[3], const double a[3], const dou
 static double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
 
 /* Ericson 5.1.9, with the parallel and degenerate cases handled. */
-double wc_segment_segment_closest(const double p0[3], const double p1[3], const double q0[3],
+double wci_segment_segment_closest(const double p0[3], const double p1[3], const double q0[3],
                                   const double q1[3], double *s_out, double *t_out)
 {
     double d1[3], d2[3], r[3];
@@ -189,7 +189,7 @@ static int cubic_roots01(const double f[4], double roots[3])
     return count;
 }
 
-int wc_ccd_point_triangle(const double p0[3], const double p1[3], const double a0[3],
+int wci_ccd_point_triangle(const double p0[3], const double p1[3], const double a0[3],
                           const double a1[3], const double b0[3], const double b1[3],
                           const double c0[3], const double c1[3], double tolerance, double *t_out,
                           double bary[3])
@@ -208,7 +208,7 @@ int wc_ccd_point_triangle(const double p0[3], const double p1[3], const double a
     for (int i = 0; i < n; ++i) {
         double t = roots[i], p[3], a[3], b[3], c[3];
         lerp(p0, p1, t, p), lerp(a0, a1, t, a), lerp(b0, b1, t, b), lerp(c0, c1, t, c);
-        if (wc_point_triangle_closest(p, a, b, c, bary) <= tolerance * tolerance) {
+        if (wci_point_triangle_closest(p, a, b, c, bary) <= tolerance * tolerance) {
             *t_out = t;
             return 1;
         }
@@ -216,7 +216,7 @@ int wc_ccd_point_triangle(const double p0[3], const double p1[3], const double a
     return 0;
 }
 
-int wc_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
+int wci_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
                      const double q1[3], const double r0[3], const double r1[3],
                      const double s0[3], const double s1[3], double tolerance, double *t_out,
                      double *u, double *v)
@@ -235,7 +235,7 @@ int wc_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
     for (int i = 0; i < n; ++i) {
         double t = roots[i], p[3], q[3], r[3], s[3];
         lerp(p0, p1, t, p), lerp(q0, q1, t, q), lerp(r0, r1, t, r), lerp(s0, s1, t, s);
-        if (wc_segment_segment_closest(p, q, r, s, u, v) <= tolerance * tolerance) {
+        if (wci_segment_segment_closest(p, q, r, s, u, v) <= tolerance * tolerance) {
             *t_out = t;
             return 1;
         }
@@ -243,7 +243,7 @@ int wc_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
     return 0;
 }
 
-void wc_sym3_inverse(const double m[6], double out[6])
+void wci_sym3_inverse(const double m[6], double out[6])
 {
     double c0 = m[3] * m[5] - m[4] * m[4], c1 = m[2] * m[4] - m[1] * m[5],
            c2 = m[1] * m[4] - m[2] * m[3];

@@ -32,16 +32,16 @@ static inline void wc_sym3_times(const double b[6], double x, double y, double z
 /// definite (determinant or xx not > 0, NaN included) gets zeros: the
 /// preconditioners that use it (implicit.c, multigrid.c) invert blocks that
 /// are positive definite, or empty ones, whose rows must stay zero.
-void wc_sym3_inverse(const double m[6], double out[6]);
+void wci_sym3_inverse(const double m[6], double out[6]);
 
 /// Closest point of triangle (a, b, c) to p. Returns the squared distance and
 /// writes the barycentric coordinates (weights of a, b, c) of the closest point.
-double wc_point_triangle_closest(const double p[3], const double a[3], const double b[3],
+double wci_point_triangle_closest(const double p[3], const double a[3], const double b[3],
                                  const double c[3], double bary[3]);
 
 /// Closest points of segments p0-p1 and q0-q1. Returns the squared distance
 /// and writes the parameters s (along p) and t (along q), both in [0, 1].
-double wc_segment_segment_closest(const double p0[3], const double p1[3], const double q0[3],
+double wci_segment_segment_closest(const double p0[3], const double p1[3], const double q0[3],
                                   const double q1[3], double *s, double *t);
 
 /// Earliest time t in [0, 1] at which point p and triangle (a, b, c), each
@@ -49,7 +49,7 @@ double wc_segment_segment_closest(const double p0[3], const double p1[3], const 
 /// point within `tolerance` (m) of the triangle. Solves the coplanarity cubic
 /// (Provot 1997; Bridson et al. 2002). Returns 1 and writes t and the
 /// barycentric coordinates of the contact at t, or 0 when they never meet.
-int wc_ccd_point_triangle(const double p0[3], const double p1[3], const double a0[3],
+int wci_ccd_point_triangle(const double p0[3], const double p1[3], const double a0[3],
                           const double a1[3], const double b0[3], const double b1[3],
                           const double c0[3], const double c1[3], double tolerance, double *t,
                           double bary[3]);
@@ -57,12 +57,12 @@ int wc_ccd_point_triangle(const double p0[3], const double p1[3], const double a
 /// Earliest time t in [0, 1] at which edges p-q and r-s, moving linearly,
 /// are coplanar and within `tolerance` of each other. Returns 1 and writes t
 /// and the parameters along each edge at that time, or 0.
-int wc_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
+int wci_ccd_edge_edge(const double p0[3], const double p1[3], const double q0[3],
                      const double q1[3], const double r0[3], const double r1[3],
                      const double s0[3], const double s1[3], double tolerance, double *t,
                      double *u, double *v);
 
 /// Unit normal of triangle (a, b, c) (right-handed); zero vector when degenerate.
-void wc_triangle_normal(const double a[3], const double b[3], const double c[3], double n[3]);
+void wci_triangle_normal(const double a[3], const double b[3], const double c[3], double n[3]);
 
 #endif

@@ -4,7 +4,7 @@
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-wc_particle_arrays wc_particle_arrays_of(wc_cloth *c)
+wc_particle_arrays wci_particle_arrays_of(wc_cloth *c)
 {
     wc_particle_arrays p;
     p.count = c->particle_count;
@@ -21,7 +21,7 @@ wc_particle_arrays wc_particle_arrays_of(wc_cloth *c)
     return p;
 }
 
-double wc_friction_keep(double mu, double normal_change, double tangential, double wet, double q)
+double wci_friction_keep(double mu, double normal_change, double tangential, double wet, double q)
 {
     double keep = 1.0;
     if (tangential > 0.0) {
@@ -96,7 +96,7 @@ static void mark(const wc_particle_arrays *p, const wc_contact *k, int32_t *mark
     }
 }
 
-int wc_response_apply(const wc_particle_arrays *p, const wc_contact *k,
+int wci_response_apply(const wc_particle_arrays *p, const wc_contact *k,
                       const wc_response_options *options, int32_t *marked, uint8_t moved[4])
 {
     double im[4];
@@ -136,7 +136,7 @@ int wc_response_apply(const wc_particle_arrays *p, const wc_contact *k,
     double lose = 0.0;
     if (dv > 0.0) {
         double wet = sustained_wetness(p, k);
-        lose = 1.0 - wc_friction_keep(k->friction, dv, sqrt(dot3(ut, ut)), wet, k->wet_friction);
+        lose = 1.0 - wci_friction_keep(k->friction, dv, sqrt(dot3(ut, ut)), wet, k->wet_friction);
     }
     /* the point's change of position (de) and of displacement (du) */
     double de[3], du[3];

@@ -4,7 +4,7 @@
  * cloth and between cloths) describes each contact it finds as a wc_contact:
  * which particles, with which barycentric weights, against what, along which
  * normal, how far apart now and how far apart the response must leave them,
- * and its friction. wc_response_apply answers it against the current state,
+ * and its friction. wci_response_apply answers it against the current state,
  * always by the same law:
  *
  *  * normal: the approach along n is removed (an inelastic impulse: a change
@@ -68,7 +68,7 @@ typedef struct wc_particle_arrays {
 } wc_particle_arrays;
 
 /// The arrays of one cloth.
-wc_particle_arrays wc_particle_arrays_of(wc_cloth *cloth);
+wc_particle_arrays wci_particle_arrays_of(wc_cloth *cloth);
 
 /// What a contact touches.
 typedef enum wc_contact_source {
@@ -120,12 +120,12 @@ typedef struct wc_response_options {
 /// element's where it had none; cloth contacts where it had none, with the
 /// normal seen from the particle's side; *marked counts those). Returns 1 if
 /// a particle moved, and then in moved[k] whether particle[k] did.
-int wc_response_apply(const wc_particle_arrays *p, const wc_contact *contact,
+int wci_response_apply(const wc_particle_arrays *p, const wc_contact *contact,
                       const wc_response_options *options, int32_t *marked, uint8_t moved[4]);
 
 /// The share of the tangential relative motion a contact keeps: Coulomb's
 /// 1 - mu * normal_change / tangential (at least 0), then, with wet > 0,
 /// times 1 - wet * (1 - q). The friction law, in one place.
-double wc_friction_keep(double mu, double normal_change, double tangential, double wet, double q);
+double wci_friction_keep(double mu, double normal_change, double tangential, double wet, double q);
 
 #endif

@@ -277,10 +277,10 @@ static int grow_int32(int32_t **buf, int64_t *capacity, int64_t needed)
     if (needed <= *capacity) return 1;
     int64_t cap = *capacity > 0 ? *capacity : 256;
     while (cap < needed) cap *= 2;
-    int32_t *p = wc_alloc_array((size_t)cap, sizeof *p);
+    int32_t *p = wci_alloc_array((size_t)cap, sizeof *p);
     if (!p) return 0;
     if (*capacity > 0) memcpy(p, *buf, (size_t)*capacity * sizeof *p);
-    wc_free(*buf);
+    wci_free(*buf);
     *buf = p;
     *capacity = cap;
     return 1;
@@ -299,8 +299,8 @@ static int sorted_contains(const int32_t *list, int32_t count, int32_t item)
 
 static void csr_free(csr *c)
 {
-    wc_free(c->start);
-    wc_free(c->items);
+    wci_free(c->start);
+    wci_free(c->items);
     c->start = c->items = NULL;
 }
 
@@ -321,8 +321,8 @@ static int compare_pairs(const void *pa, const void *pb)
 static int csr_from_pairs(csr *out, int32_t lists, int32_t *pairs, int64_t count, int unique)
 {
     qsort(pairs, (size_t)count, 2 * sizeof *pairs, compare_pairs);
-    out->start = wc_alloc_array((size_t)lists + 1, sizeof *out->start);
-    out->items = wc_alloc_array((size_t)count, sizeof *out->items);
+    out->start = wci_alloc_array((size_t)lists + 1, sizeof *out->start);
+    out->items = wci_alloc_array((size_t)count, sizeof *out->items);
     if (!out->start || !out->items) return 0;
     int64_t n = 0;
     for (int64_t k = 0; k < count; ++k) {
@@ -355,7 +355,7 @@ static int build_edges(wc_self_state *s, const wc_cloth *c, int32_t *neighbours)
 {
     int32_t t_count = s->triangle_count;
     size_t entries = 3 * (size_t)t_count;
-    edge_entry *e = wc_alloc_array(entries, sizeof *e);
+    edge_entry *e = wci_alloc_array(entries, sizeof *e);
     if (!e) return 0;
     for (int32_t t = 0; t < t_count; ++t)
         for (int k = 0; k < 3; ++k) {
@@ -368,10 +368,10 @@ static int build_edges(wc_self_state *s, const wc_cloth *c, int32_t *neighbours)
     for (size_t k = 0; k < entries; ++k)
         if (k == 0 || e[k].a != e[k - 1].a || e[k].b != e[k - 1].b) ++unique;
     s->edge_count = unique;
-    s->edges = wc_alloc_array(2 * (size_t)unique, sizeof *s->edges);
-    s->edge_owner = wc_alloc_array((size_t)unique, sizeof *s->edge_owner);
+    s->edges = wci_alloc_array(2 * (size_t)unique, sizeof *s->edges);
+    s->edge_owner = wci_alloc_array((size_t)unique, sizeof *s->edge_owner);
     if (!s->edges || !s->edge_owner) {
-        wc_free(e);
+        wci_free(e);
         return 0;
     }
     for (size_t k = 0; k < entries; ++k) neighbours[k] = -1;
@@ -398,7 +398,7 @@ static int build_edges(wc_self_state *s, const wc_cloth *c, int32_t *neighbours)
         }
     }
     s->mean_edge = unique ? total / unique : 0.0;
-    wc_free(e);
+    wci_free(e);
     return 1;
 }
 
@@ -434,10 +434,10 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
 {
     int32_t nt = s->triangle_count, n = s->particle_count;
     double cell = PATCH_CELL_EDGES * (s->mean_edge > 0.0 ? s->mean_edge : 1.0);
-    bin_entry *bins = wc_alloc_array((size_t)nt, sizeof *bins);
-    int32_t *bin_of = wc_alloc_array((size_t)nt, sizeof *bin_of);
-    int32_t *queue = wc_alloc_array((size_t)nt, sizeof *queue);
-    s->triangle_patch = wc_alloc_array((size_t)nt, sizeof *s->triangle_patch);
+    bin_entry *bins = wci_alloc_array((size_t)nt, sizeof *bins);
+    int32_t *bin_of = wci_alloc_array((size_t)nt, sizeof *bin_of);
+    int32_t *queue = wci_alloc_array((size_t)nt, sizeof *queue);
+    s->triangle_patch = wci_alloc_array((size_t)nt, sizeof *s->triangle_patch);
     int ok = bins && bin_of && queue && s->triangle_patch;
     if (ok) {
         for (int32_t t = 0; t < nt; ++t) {
@@ -476,19 +476,19 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
         }
         s->patch_count = patches;
     }
-    wc_free(bins);
-    wc_free(bin_of);
-    wc_free(queue);
+    wci_free(bins);
+    wci_free(bin_of);
+    wci_free(queue);
     if (!ok) return 0;
 
     /* Lists per patch, from (patch, item) pairs. */
     int32_t np = s->patch_count;
     size_t most = 3 * (size_t)nt > (size_t)s->edge_count ? 3 * (size_t)nt : (size_t)s->edge_count;
-    int32_t *pairs = wc_alloc_array(2 * most, sizeof *pairs);
-    int32_t *owner = wc_alloc_array((size_t)n, sizeof *owner);
+    int32_t *pairs = wci_alloc_array(2 * most, sizeof *pairs);
+    int32_t *owner = wci_alloc_array((size_t)n, sizeof *owner);
     if (!pairs || !owner) {
-        wc_free(pairs);
-        wc_free(owner);
+        wci_free(pairs);
+        wci_free(owner);
         return 0;
     }
     for (int32_t t = 0; t < nt; ++t) pairs[2 * t] = s->triangle_patch[t], pairs[2 * t + 1] = t;
@@ -510,27 +510,27 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
     for (int32_t e = 0; e < s->edge_count && ok; ++e)
         pairs[2 * e] = s->triangle_patch[s->edge_owner[e]], pairs[2 * e + 1] = e;
     ok = ok && csr_from_pairs(&s->patch_owned_edges, np, pairs, s->edge_count, 0);
-    wc_free(pairs);
-    wc_free(owner);
+    wci_free(pairs);
+    wci_free(owner);
     if (!ok) return 0;
 
     /* Adjacency: patches sharing a particle. Invert the particle lists, then
      * pair up the patches of each particle. */
     csr of_particle = {NULL, NULL};
     int64_t entries = s->patch_particles.start[np];
-    pairs = wc_alloc_array(2 * (size_t)entries, sizeof *pairs);
+    pairs = wci_alloc_array(2 * (size_t)entries, sizeof *pairs);
     if (!pairs) return 0;
     for (int32_t p = 0; p < np; ++p)
         for (int32_t k = s->patch_particles.start[p]; k < s->patch_particles.start[p + 1]; ++k)
             pairs[2 * (size_t)k] = s->patch_particles.items[k], pairs[2 * (size_t)k + 1] = p;
     ok = csr_from_pairs(&of_particle, n, pairs, entries, 0);
-    wc_free(pairs);
+    wci_free(pairs);
     int64_t links = 0;
     for (int32_t i = 0; i < n && ok; ++i) {
         int64_t m = of_particle.start[i + 1] - of_particle.start[i];
         links += m * (m - 1);
     }
-    pairs = ok ? wc_alloc_array(2 * (size_t)(links > 0 ? links : 1), sizeof *pairs) : NULL;
+    pairs = ok ? wci_alloc_array(2 * (size_t)(links > 0 ? links : 1), sizeof *pairs) : NULL;
     if (pairs) {
         int64_t at = 0;
         for (int32_t i = 0; i < n; ++i)
@@ -542,7 +542,7 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
     } else {
         ok = 0;
     }
-    wc_free(pairs);
+    wci_free(pairs);
     csr_free(&of_particle);
     return ok;
 }
@@ -553,11 +553,11 @@ static int set_pieces(wc_self_state *s, const wc_self_pieces *pieces)
 {
     int32_t m = pieces->count;
     s->piece_count = m;
-    s->particle_piece = wc_alloc_array((size_t)s->particle_count, sizeof *s->particle_piece);
-    s->patch_piece = wc_alloc_array((size_t)s->patch_count, sizeof *s->patch_piece);
-    s->piece_self = wc_alloc_array((size_t)m, 1);
-    s->piece_friction = wc_alloc_array((size_t)m, sizeof *s->piece_friction);
-    s->piece_wet_friction = wc_alloc_array((size_t)m, sizeof *s->piece_wet_friction);
+    s->particle_piece = wci_alloc_array((size_t)s->particle_count, sizeof *s->particle_piece);
+    s->patch_piece = wci_alloc_array((size_t)s->patch_count, sizeof *s->patch_piece);
+    s->piece_self = wci_alloc_array((size_t)m, 1);
+    s->piece_friction = wci_alloc_array((size_t)m, sizeof *s->piece_friction);
+    s->piece_wet_friction = wci_alloc_array((size_t)m, sizeof *s->piece_wet_friction);
     if (!s->particle_piece || !s->patch_piece || !s->piece_self || !s->piece_friction ||
         !s->piece_wet_friction)
         return 0;
@@ -568,65 +568,65 @@ static int set_pieces(wc_self_state *s, const wc_self_pieces *pieces)
         s->patch_piece[p] = s->particle_piece[s->triangles[3 * (size_t)t]];
     }
     memcpy(s->piece_self, pieces->self, (size_t)m);
-    wc_self_state_set_friction(s, pieces->friction, pieces->wet_friction);
+    wci_self_state_set_friction(s, pieces->friction, pieces->wet_friction);
     return 1;
 }
 
-void wc_self_state_set_friction(wc_self_state *s, const double *friction, const double *wet_friction)
+void wci_self_state_set_friction(wc_self_state *s, const double *friction, const double *wet_friction)
 {
     memcpy(s->piece_friction, friction, (size_t)s->piece_count * sizeof *friction);
     memcpy(s->piece_wet_friction, wet_friction, (size_t)s->piece_count * sizeof *wet_friction);
 }
 
-void wc_self_state_invalidate(wc_self_state *s) { s->built = 0; }
+void wci_self_state_invalidate(wc_self_state *s) { s->built = 0; }
 
-const double *wc_self_state_rest(const wc_self_state *s) { return s->rest; }
+const double *wci_self_state_rest(const wc_self_state *s) { return s->rest; }
 
-wc_self_state *wc_self_state_create(const wc_cloth *c) { return wc_self_state_create_pieces(c, NULL); }
+wc_self_state *wci_self_state_create(const wc_cloth *c) { return wci_self_state_create_pieces(c, NULL); }
 
-wc_self_state *wc_self_state_create_pieces(const wc_cloth *c, const wc_self_pieces *pieces)
+wc_self_state *wci_self_state_create_pieces(const wc_cloth *c, const wc_self_pieces *pieces)
 {
-    wc_self_state *s = wc_alloc_array(1, sizeof *s);
+    wc_self_state *s = wci_alloc_array(1, sizeof *s);
     if (!s) return NULL;
     size_t n = (size_t)c->particle_count, nt = (size_t)c->topology.triangle_count;
     s->particle_count = c->particle_count;
     s->triangle_count = c->topology.triangle_count;
     s->triangles = c->topology.triangles;
-    wc_grid_init(&s->patch_grid);
-    s->rest = wc_alloc_array(3 * n, sizeof *s->rest);
-    int32_t *neighbours = wc_alloc_array(3 * nt, sizeof *neighbours);
+    memset(&s->patch_grid, 0, sizeof s->patch_grid);
+    s->rest = wci_alloc_array(3 * n, sizeof *s->rest);
+    int32_t *neighbours = wci_alloc_array(3 * nt, sizeof *neighbours);
     int ok = s->rest && neighbours && build_edges(s, c, neighbours);
     if (ok) {
         for (size_t i = 0; i < n; ++i) load(c->x, c->y, c->z, (int32_t)i, s->rest + 3 * i);
         ok = build_patches(s, neighbours);
     }
-    wc_free(neighbours);
+    wci_free(neighbours);
     if (!ok) {
-        wc_self_state_destroy(s);
+        wci_self_state_destroy(s);
         return NULL;
     }
     size_t np = (size_t)s->patch_count, adjacency = (size_t)s->patch_adjacent.start[np];
-    s->rest_triangle_boxes = wc_alloc_array(6 * nt, sizeof *s->rest_triangle_boxes);
-    s->rest_edge_boxes = wc_alloc_array(6 * (size_t)s->edge_count, sizeof *s->rest_edge_boxes);
-    s->particle_boxes = wc_alloc_array(6 * n, sizeof *s->particle_boxes);
-    s->triangle_boxes = wc_alloc_array(6 * nt, sizeof *s->triangle_boxes);
-    s->edge_boxes = wc_alloc_array(6 * (size_t)s->edge_count, sizeof *s->edge_boxes);
-    s->triangle_normals = wc_alloc_array(9 * nt, sizeof *s->triangle_normals);
-    s->patch_boxes = wc_alloc_array(6 * np, sizeof *s->patch_boxes);
-    s->patch_grown = wc_alloc_array(6 * np, sizeof *s->patch_grown);
-    s->patch_axis = wc_alloc_array(3 * np, sizeof *s->patch_axis);
-    s->patch_cos = wc_alloc_array(np, sizeof *s->patch_cos);
-    s->patch_fit = wc_alloc_array(np, sizeof *s->patch_fit);
-    s->patch_culled = wc_alloc_array(np, 1);
-    s->patch_touched = wc_alloc_array(np, 1);
-    s->adjacent_culled = wc_alloc_array(adjacency, 1);
-    s->dirty = wc_alloc_array(n, 1);
-    s->reverted = wc_alloc_array(n, 1);
+    s->rest_triangle_boxes = wci_alloc_array(6 * nt, sizeof *s->rest_triangle_boxes);
+    s->rest_edge_boxes = wci_alloc_array(6 * (size_t)s->edge_count, sizeof *s->rest_edge_boxes);
+    s->particle_boxes = wci_alloc_array(6 * n, sizeof *s->particle_boxes);
+    s->triangle_boxes = wci_alloc_array(6 * nt, sizeof *s->triangle_boxes);
+    s->edge_boxes = wci_alloc_array(6 * (size_t)s->edge_count, sizeof *s->edge_boxes);
+    s->triangle_normals = wci_alloc_array(9 * nt, sizeof *s->triangle_normals);
+    s->patch_boxes = wci_alloc_array(6 * np, sizeof *s->patch_boxes);
+    s->patch_grown = wci_alloc_array(6 * np, sizeof *s->patch_grown);
+    s->patch_axis = wci_alloc_array(3 * np, sizeof *s->patch_axis);
+    s->patch_cos = wci_alloc_array(np, sizeof *s->patch_cos);
+    s->patch_fit = wci_alloc_array(np, sizeof *s->patch_fit);
+    s->patch_culled = wci_alloc_array(np, 1);
+    s->patch_touched = wci_alloc_array(np, 1);
+    s->adjacent_culled = wci_alloc_array(adjacency, 1);
+    s->dirty = wci_alloc_array(n, 1);
+    s->reverted = wci_alloc_array(n, 1);
     if (!s->particle_boxes || !s->triangle_boxes || !s->edge_boxes || !s->triangle_normals ||
         !s->patch_boxes || !s->patch_grown || !s->patch_axis || !s->patch_cos || !s->patch_fit ||
         !s->patch_culled || !s->patch_touched || !s->adjacent_culled || !s->dirty || !s->reverted ||
         !s->rest_triangle_boxes || !s->rest_edge_boxes) {
-        wc_self_state_destroy(s);
+        wci_self_state_destroy(s);
         return NULL;
     }
     for (size_t t = 0; t < nt; ++t) {
@@ -644,13 +644,13 @@ wc_self_state *wc_self_state_create_pieces(const wc_cloth *c, const wc_self_piec
         for (int k = 0; k < 3; ++k) box[k] = min2(a[k], b[k]), box[k + 3] = max2(a[k], b[k]);
     }
     if (pieces && !set_pieces(s, pieces)) {
-        wc_self_state_destroy(s);
+        wci_self_state_destroy(s);
         return NULL;
     }
     return s;
 }
 
-void wc_self_state_destroy(wc_self_state *s)
+void wci_self_state_destroy(wc_self_state *s)
 {
     if (!s) return;
     void *blocks[] = {s->edges, s->edge_owner, s->rest, s->rest_triangle_boxes,
@@ -661,19 +661,19 @@ void wc_self_state_destroy(wc_self_state *s)
                       s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted, s->vf_h,
                       s->particle_piece, s->patch_piece, s->piece_self, s->piece_friction,
                       s->piece_wet_friction};
-    for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wc_free(blocks[k]);
+    for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wci_free(blocks[k]);
     csr_free(&s->patch_triangles);
     csr_free(&s->patch_particles);
     csr_free(&s->patch_owned_particles);
     csr_free(&s->patch_owned_edges);
     csr_free(&s->patch_adjacent);
-    wc_grid_free(&s->patch_grid);
+    wci_grid_destroy(&s->patch_grid);
     for (int k = 0; k < SLICES; ++k) {
-        wc_free(s->slices[k].pairs);
-        wc_free(s->slices[k].values);
-        wc_free(s->slices[k].query);
+        wci_free(s->slices[k].pairs);
+        wci_free(s->slices[k].values);
+        wci_free(s->slices[k].query);
     }
-    wc_free(s);
+    wci_free(s);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -822,7 +822,7 @@ static void patch_pairs_slice(wc_self_state *s, pair_slice *sl, int32_t first, i
     for (int32_t p = first; p < end && !sl->failed; ++p) {
         int32_t found;
         for (;;) {
-            found = wc_grid_query(&s->patch_grid, s->patch_boxes + 6 * (size_t)p, sl->query,
+            found = wci_grid_query(&s->patch_grid, s->patch_boxes + 6 * (size_t)p, sl->query,
                                   sl->query_capacity);
             if (found <= sl->query_capacity) break;
             int64_t cap = sl->query_capacity;
@@ -881,13 +881,13 @@ static void slice_value(pair_slice *sl, double value)
     if (sl->count > sl->value_capacity) {
         int64_t cap = sl->value_capacity > 0 ? sl->value_capacity : 256;
         while (cap < sl->count) cap *= 2;
-        double *p = wc_alloc_array((size_t)cap, sizeof *p);
+        double *p = wci_alloc_array((size_t)cap, sizeof *p);
         if (!p) {
             sl->failed = 1;
             return;
         }
         if (sl->value_capacity > 0) memcpy(p, sl->values, (size_t)sl->value_capacity * sizeof *p);
-        wc_free(sl->values);
+        wci_free(sl->values);
         sl->values = p;
         sl->value_capacity = cap;
     }
@@ -949,7 +949,7 @@ static double rest2_vf(const self_ctx *ctx, const int32_t ids[4])
     if (across_pieces(ctx, ids)) return INFINITY;
     double bary[3];
     const double *r = ctx->rest;
-    return wc_point_triangle_closest(r + 3 * (size_t)ids[0], r + 3 * (size_t)ids[1],
+    return wci_point_triangle_closest(r + 3 * (size_t)ids[0], r + 3 * (size_t)ids[1],
                                      r + 3 * (size_t)ids[2], r + 3 * (size_t)ids[3], bary);
 }
 
@@ -958,7 +958,7 @@ static double rest2_ee(const self_ctx *ctx, const int32_t ids[4])
     if (across_pieces(ctx, ids)) return INFINITY;
     double u, v;
     const double *r = ctx->rest;
-    return wc_segment_segment_closest(r + 3 * (size_t)ids[0], r + 3 * (size_t)ids[1],
+    return wci_segment_segment_closest(r + 3 * (size_t)ids[0], r + 3 * (size_t)ids[1],
                                       r + 3 * (size_t)ids[2], r + 3 * (size_t)ids[3], &u, &v);
 }
 
@@ -1050,11 +1050,11 @@ static int gather(const pair_slice *slices, int stride, int32_t **pairs, uint8_t
     if (total > *capacity) {
         int64_t cap = *capacity > 0 ? *capacity : 1024;
         while (cap < total) cap *= 2;
-        wc_free(*pairs);
-        *pairs = wc_alloc_array((size_t)stride * (size_t)cap, sizeof **pairs);
+        wci_free(*pairs);
+        *pairs = wci_alloc_array((size_t)stride * (size_t)cap, sizeof **pairs);
         if (status) {
-            wc_free(*status);
-            *status = wc_alloc_array((size_t)cap, 1);
+            wci_free(*status);
+            *status = wci_alloc_array((size_t)cap, 1);
         }
         *capacity = (*pairs && (!status || *status)) ? cap : 0;
         if (!*capacity) return 0;
@@ -1121,7 +1121,7 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
     }
     double cell = np ? extent / np : 1.0;
     if (!(cell > 0.0) || !isfinite(cell)) cell = 1.0;
-    if (wc_grid_build(&s->patch_grid, s->patch_grown, np, cell)) return WC_ERROR_OUT_OF_MEMORY;
+    if (wci_grid_update(&s->patch_grid, s->patch_grown, np, cell)) return WC_ERROR_OUT_OF_MEMORY;
 
     for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0, s->slices[k].failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
@@ -1169,8 +1169,8 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
     if (!gather(s->slices, 2, &s->vf, &s->vf_status, &s->vf_count, &s->vf_capacity))
         return WC_ERROR_OUT_OF_MEMORY;
     if (s->vf_h_capacity < s->vf_capacity) {
-        wc_free(s->vf_h);
-        s->vf_h = wc_alloc_array((size_t)s->vf_capacity, sizeof *s->vf_h);
+        wci_free(s->vf_h);
+        s->vf_h = wci_alloc_array((size_t)s->vf_capacity, sizeof *s->vf_h);
         s->vf_h_capacity = s->vf_h ? s->vf_capacity : 0;
         if (!s->vf_h) return WC_ERROR_OUT_OF_MEMORY;
     }
@@ -1298,7 +1298,7 @@ static int eval_vf(const self_ctx *ctx, int32_t v, const int32_t *tri, double *h
     if (!load_pair(ctx, ids, 1, ctx->h, p0, p1, u)) return NO_CONTACT;
     for (int j = 0; j < 4; ++j) k->p[j] = ids[j];
     double bary1[3];
-    double d1 = sqrt(wc_point_triangle_closest(p1[0], p1[1], p1[2], p1[3], bary1));
+    double d1 = sqrt(wci_point_triangle_closest(p1[0], p1[1], p1[2], p1[3], bary1));
     /* The distance changes at most at rate L, so over the step it stays above
      * d1 - L, and above (d0 + d1 - L) / 2: when that exceeds the tolerance
      * the cubic cannot find a collision. d0 only when d1 alone cannot tell. */
@@ -1306,11 +1306,11 @@ static int eval_vf(const self_ctx *ctx, int32_t v, const int32_t *tri, double *h
     int ccd = d1 - lip <= ctx->tol;
     if (ccd) {
         double bary0[3];
-        double d0 = sqrt(wc_point_triangle_closest(p0[0], p0[1], p0[2], p0[3], bary0));
+        double d0 = sqrt(wci_point_triangle_closest(p0[0], p0[1], p0[2], p0[3], bary0));
         ccd = 0.5 * (d0 + d1 - lip) <= ctx->tol;
     }
     double t, bary[3];
-    if (ccd && wc_ccd_point_triangle(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3],
+    if (ccd && wci_ccd_point_triangle(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3],
                                      ctx->tol, &t, bary)) {
         k->kind = COLLISION;
         if (*hp < 0.0) *hp = pair_thickness(ctx, rest2_vf(ctx, ids));
@@ -1318,7 +1318,7 @@ static int eval_vf(const self_ctx *ctx, int32_t v, const int32_t *tri, double *h
         k->w[0] = 1.0, k->w[1] = -bary[0], k->w[2] = -bary[1], k->w[3] = -bary[2];
         double a[3], b[3], c[3];
         lerp3(p0[1], p1[1], t, a), lerp3(p0[2], p1[2], t, b), lerp3(p0[3], p1[3], t, c);
-        wc_triangle_normal(a, b, c, k->n);
+        wci_triangle_normal(a, b, c, k->n);
         if (dot3(k->n, k->n) == 0.0) fallback_normal(ctx, k, t);
         orient(ctx, k);
         return COLLISION;
@@ -1333,7 +1333,7 @@ static int eval_vf(const self_ctx *ctx, int32_t v, const int32_t *tri, double *h
         k->n[m] = p1[0][m] - (bary1[0] * p1[1][m] + bary1[1] * p1[2][m] + bary1[2] * p1[3][m]);
     /* At (nearly) zero distance the direction is noise: use the face normal. */
     if (!(d1 > 1e-9 * ctx->h) || !normalize3(k->n)) {
-        wc_triangle_normal(p1[1], p1[2], p1[3], k->n);
+        wci_triangle_normal(p1[1], p1[2], p1[3], k->n);
         if (dot3(k->n, k->n) == 0.0) fallback_normal(ctx, k, 1.0);
     }
     orient(ctx, k);
@@ -1349,16 +1349,16 @@ static int eval_ee(const self_ctx *ctx, const int32_t *e, const int32_t *f, int 
     if (!load_pair(ctx, ids, 2, ctx->tol, p0, p1, u)) return NO_CONTACT;
     for (int j = 0; j < 4; ++j) k->p[j] = ids[j];
     double s1, t1;
-    double d1 = sqrt(wc_segment_segment_closest(p1[0], p1[1], p1[2], p1[3], &s1, &t1));
+    double d1 = sqrt(wci_segment_segment_closest(p1[0], p1[1], p1[2], p1[3], &s1, &t1));
     double lip = max_relative_motion(u, 2);
     int ccd = d1 - lip <= ctx->tol;
     if (ccd) {
         double s0, t0;
-        double d0 = sqrt(wc_segment_segment_closest(p0[0], p0[1], p0[2], p0[3], &s0, &t0));
+        double d0 = sqrt(wci_segment_segment_closest(p0[0], p0[1], p0[2], p0[3], &s0, &t0));
         ccd = 0.5 * (d0 + d1 - lip) <= ctx->tol;
     }
     double t, s, v;
-    if (ccd && wc_ccd_edge_edge(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3], ctx->tol,
+    if (ccd && wci_ccd_edge_edge(p0[0], p1[0], p0[1], p1[1], p0[2], p1[2], p0[3], p1[3], ctx->tol,
                                 &t, &s, &v)) {
         k->kind = COLLISION;
         k->h = pair_thickness(ctx, rest2_ee(ctx, ids));
@@ -1462,10 +1462,10 @@ static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, const d
     double h = k->h;
     ct.target = k->kind == COLLISION ? (k->d0 > h ? h : k->d0 < 0.1 * h ? 0.1 * h : k->d0) : h;
     ct.friction = friction[0], ct.wet_friction = friction[1];
-    wc_particle_arrays p = wc_particle_arrays_of(c);
+    wc_particle_arrays p = wci_particle_arrays_of(c);
     wc_response_options options = {slack};
     uint8_t moved[4];
-    if (!wc_response_apply(&p, &ct, &options, marked, moved)) return 0;
+    if (!wci_response_apply(&p, &ct, &options, marked, moved)) return 0;
     for (int j = 0; j < 4; ++j)
         if (moved[j]) s->dirty[k->p[j]] = 1;
     return 1;
@@ -1623,26 +1623,26 @@ static void note_adhesive(wc_cloth *c, wc_self_state *s, const self_ctx *ctx)
         double p[4][3];
         load(c->nx, c->ny, c->nz, pr[0], p[0]);
         for (int j = 0; j < 3; ++j) load(c->nx, c->ny, c->nz, tri[j], p[1 + j]);
-        if (!(wc_point_triangle_closest(p[0], p[1], p[2], p[3], bary) < reach * reach)) continue;
+        if (!(wci_point_triangle_closest(p[0], p[1], p[2], p[3], bary) < reach * reach)) continue;
         int32_t ids[4] = {pr[0], tri[0], tri[1], tri[2]};
         if (s->vf_h[i] < 0.0) s->vf_h[i] = pair_thickness(ctx, rest2_vf(ctx, ids));
-        if (s->vf_h[i] == ctx->h) wc_wet_note_self_contact(c, pr[0], pr[1]);
+        if (s->vf_h[i] == ctx->h) wci_wet_note_self_contact(c, pr[0], pr[1]);
     }
 }
 
-double wc_self_thickness(const wc_cloth *c)
+double wci_self_thickness(const wc_cloth *c)
 {
     return max2(c->material.thickness, MIN_THICKNESS * c->self->mean_edge);
 }
 
-wc_status wc_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *stats)
+wc_status wci_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *stats)
 {
     (void)dt; /* everything works in displacements over the step */
     wc_self_state *s = c->self;
     if (!s || s->triangle_count == 0) return WC_OK;
     if (threads < 1) threads = 1;
     self_ctx ctx;
-    ctx.h = wc_self_thickness(c);
+    ctx.h = wci_self_thickness(c);
     ctx.tol = CCD_TOLERANCE * ctx.h;
     ctx.exclude2 = (REST_EXCLUSION * ctx.h) * (REST_EXCLUSION * ctx.h);
     ctx.rest = s->rest;

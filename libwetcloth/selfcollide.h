@@ -13,8 +13,8 @@ typedef struct wc_self_state wc_self_state;
 
 /// Allocates the state for a cloth (its topology must be built). NULL on
 /// out-of-memory.
-wc_self_state *wc_self_state_create(const wc_cloth *cloth);
-void wc_self_state_destroy(wc_self_state *state);
+wc_self_state *wci_self_state_create(const wc_cloth *cloth);
+void wci_self_state_destroy(wc_self_state *state);
 
 /// Several cloths as pieces of one combined cloth (cloth_group.h): piece k
 /// holds particles [first[k], first[k + 1]). Pairs of two pieces are always
@@ -30,19 +30,19 @@ typedef struct wc_self_pieces {
 
 /// The state for a combined cloth of pieces (copied); the combined cloth's
 /// positions are the rest shape. NULL on out-of-memory.
-wc_self_state *wc_self_state_create_pieces(const wc_cloth *combined, const wc_self_pieces *pieces);
+wc_self_state *wci_self_state_create_pieces(const wc_cloth *combined, const wc_self_pieces *pieces);
 
 /// New friction and wet friction per piece (materials can change).
-void wc_self_state_set_friction(wc_self_state *state, const double *friction,
+void wci_self_state_set_friction(wc_self_state *state, const double *friction,
                                 const double *wet_friction);
 
 /// Drops the candidate pairs: the next call rebuilds them. For a state that
 /// skipped steps, in which its particles moved out of the boxes the
 /// candidates were made for.
-void wc_self_state_invalidate(wc_self_state *state);
+void wci_self_state_invalidate(wc_self_state *state);
 
 /// The rest shape the state was made with, xyz per particle.
-const double *wc_self_state_rest(const wc_self_state *state);
+const double *wci_self_state_rest(const wc_self_state *state);
 
 /// Resolves self-collisions of the motion from (x, y, z) to (nx, ny, nz):
 /// moves nx/ny/nz, sets the history override (qx/qy/qz, history_override)
@@ -50,11 +50,11 @@ const double *wc_self_state_rest(const wc_self_state *state);
 /// contacts (contact = WC_CONTACT_CLOTH, normal). Pinned particles do not
 /// move. Adds to stats->cloth_contacts and stats->failsafe_particles.
 /// Deterministic for any thread count.
-wc_status wc_self_collide(wc_cloth *cloth, double dt, int threads, wc_step_stats *stats);
+wc_status wci_self_collide(wc_cloth *cloth, double dt, int threads, wc_step_stats *stats);
 
 /// The thickness self-collision keeps between layers of a cloth that has
 /// self-collision: the material's, but at least a small fraction of the mean
 /// rest edge length.
-double wc_self_thickness(const wc_cloth *cloth);
+double wci_self_thickness(const wc_cloth *cloth);
 
 #endif

@@ -4,7 +4,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 
-wc_status wc_fail(wc_message *msg, wc_status status, const char *format, ...)
+wc_status wci_fail(wc_message *msg, wc_status status, const char *format, ...)
 {
     if (msg) {
         va_list args;
@@ -15,7 +15,7 @@ wc_status wc_fail(wc_message *msg, wc_status status, const char *format, ...)
     return status;
 }
 
-long wc_first_non_finite(const double *values, long count)
+long wci_first_non_finite(const double *values, long count)
 {
     for (long i = 0; i < count; ++i)
         if (!isfinite(values[i])) return i;

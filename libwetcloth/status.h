@@ -12,9 +12,9 @@
 #endif
 
 /// Writes a formatted message into msg (which may be NULL) and returns status.
-wc_status wc_fail(wc_message *msg, wc_status status, const char *format, ...) WC_PRINTF(3, 4);
+wc_status wci_fail(wc_message *msg, wc_status status, const char *format, ...) WC_PRINTF(3, 4);
 
 /// Index of the first non-finite value of values[0 .. count), or -1.
-long wc_first_non_finite(const double *values, long count);
+long wci_first_non_finite(const double *values, long count);
 
 #endif

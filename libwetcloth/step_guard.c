@@ -28,7 +28,7 @@
 static double change_at(const wc_cloth *c, int32_t i, double dt, double dv[3])
 {
     double v[3];
-    wc_cloth_velocity(c, i, v);
+    wci_cloth_velocity(c, i, v);
     dv[0] = (c->nx[i] - c->x[i]) / dt - v[0];
     dv[1] = (c->ny[i] - c->y[i]) / dt - v[1];
     dv[2] = (c->nz[i] - c->z[i]) / dt - v[2];
@@ -67,7 +67,7 @@ static double mean_link_length(const wc_cloth *c)
     return s->count ? sum / s->count : 1.0;
 }
 
-int32_t wc_step_guard_check(const wc_cloth *c, const wc_step_guard *g, double dt, int threads,
+int32_t wci_step_guard_check(const wc_cloth *c, const wc_step_guard *g, double dt, int threads,
                             wc_step_guard *next)
 {
     *next = *g;

@@ -49,7 +49,7 @@ typedef struct wc_step_guard {
 /// Looks at the step from (x, y, z) to (nx, ny, nz) of length dt; writes
 /// what the guard would keep if the step is committed to *next. Returns
 /// the particle whose growing oscillation makes the step unstable, or -1.
-int32_t wc_step_guard_check(const struct wc_cloth *cloth, const wc_step_guard *guard, double dt,
+int32_t wci_step_guard_check(const struct wc_cloth *cloth, const wc_step_guard *guard, double dt,
                             int threads, wc_step_guard *next);
 
 #endif

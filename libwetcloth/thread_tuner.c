@@ -39,7 +39,7 @@ static double median3(const double *t)
     return max2(min2(t[0], t[1]), min2(max2(t[0], t[1]), t[2]));
 }
 
-void wc_thread_tuner_create(wc_thread_tuner *t, int32_t most, int32_t adapt)
+void wci_thread_tuner_create(wc_thread_tuner *t, int32_t most, int32_t adapt)
 {
     t->most = most < 1 ? 1 : most;
     t->adapt = adapt && t->most > 1;
@@ -52,7 +52,7 @@ void wc_thread_tuner_create(wc_thread_tuner *t, int32_t most, int32_t adapt)
     t->reference = 0.0;
 }
 
-int32_t wc_thread_tuner_threads(const wc_thread_tuner *t) { return t->current; }
+int32_t wci_thread_tuner_threads(const wc_thread_tuner *t) { return t->current; }
 
 /* The neighbouring count of the chosen one that way, or 0 when there is
  * none. */
@@ -114,7 +114,7 @@ static void record_probe_step(wc_thread_tuner *t, double seconds)
     t->current = PROBE_ORDER[t->probe_step] ? t->probed : t->chosen;
 }
 
-void wc_thread_tuner_record(wc_thread_tuner *t, double seconds)
+void wci_thread_tuner_record(wc_thread_tuner *t, double seconds)
 {
     WC_ASSERT(t->current >= 1 && t->current <= t->most);
     if (!t->adapt) return;

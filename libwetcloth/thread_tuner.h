@@ -58,13 +58,13 @@ typedef struct wc_thread_tuner {
 } wc_thread_tuner;
 
 /// Starts a tuner for up to `most` threads (>= 1), adapting when `adapt`.
-void wc_thread_tuner_create(wc_thread_tuner *tuner, int32_t most, int32_t adapt);
+void wci_thread_tuner_create(wc_thread_tuner *tuner, int32_t most, int32_t adapt);
 
 /// Threads for the next step.
-int32_t wc_thread_tuner_threads(const wc_thread_tuner *tuner);
+int32_t wci_thread_tuner_threads(const wc_thread_tuner *tuner);
 
-/// Records how long the step just taken, on wc_thread_tuner_threads()
+/// Records how long the step just taken, on wci_thread_tuner_threads()
 /// threads, took (seconds), and picks the count of the next one.
-void wc_thread_tuner_record(wc_thread_tuner *tuner, double seconds);
+void wci_thread_tuner_record(wc_thread_tuner *tuner, double seconds);
 
 #endif

@@ -67,13 +67,13 @@ static wc_status check_face(const double *xyz, int32_t n, const int32_t *face, i
     if (face_size == 4 && face[3] == -1) m = 3;
     for (int32_t c = 0; c < m; ++c) {
         if (face[c] < 0 || face[c] >= n)
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "cloth face %d uses vertex %d, but the cloth has %d vertices (valid: 0..%d%s)",
                            (int)index, (int)face[c], (int)n, (int)n - 1,
                            face_size == 4 && c == 3 ? ", or -1 to make a triangle" : "");
         for (int32_t d = 0; d < c; ++d)
             if (face[d] == face[c])
-                return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+                return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                                "cloth face %d uses vertex %d twice", (int)index, (int)face[c]);
     }
     /* A face is degenerate when its area is negligible next to its size; for
@@ -83,7 +83,7 @@ static wc_status check_face(const double *xyz, int32_t n, const int32_t *face, i
     double a0 = triangle_area(xyz, face[0], face[1], face[2], &l0);
     double a1 = m == 4 ? triangle_area(xyz, face[0], face[2], face[3], &l1) : 0.0;
     if (!(a0 > 1e-12 * l0) || (m == 4 && !(a1 > 1e-12 * l1)))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "cloth face %d is degenerate: its vertices are collinear or coincide "
                        "(area %g m^2)", (int)index, a0 + a1);
     *corners = m;
@@ -93,20 +93,20 @@ static wc_status check_face(const double *xyz, int32_t n, const int32_t *face, i
 
 static void link_set_free(wc_link_set *s)
 {
-    wc_free(s->a);
-    wc_free(s->b);
-    wc_free(s->rest);
-    wc_free(s->share);
+    wci_free(s->a);
+    wci_free(s->b);
+    wci_free(s->rest);
+    wci_free(s->share);
     memset(s, 0, sizeof *s);
 }
 
 static int link_set_alloc(wc_link_set *s, int32_t count)
 {
     s->count = count;
-    s->a = wc_alloc_array((size_t)count, sizeof *s->a);
-    s->b = wc_alloc_array((size_t)count, sizeof *s->b);
-    s->rest = wc_alloc_array((size_t)count, sizeof *s->rest);
-    s->share = wc_alloc_array((size_t)count, sizeof *s->share);
+    s->a = wci_alloc_array((size_t)count, sizeof *s->a);
+    s->b = wci_alloc_array((size_t)count, sizeof *s->b);
+    s->rest = wci_alloc_array((size_t)count, sizeof *s->rest);
+    s->share = wci_alloc_array((size_t)count, sizeof *s->share);
     if (s->a && s->b && s->rest && s->share) return 1;
     link_set_free(s);
     return 0;
@@ -150,7 +150,7 @@ static wc_status build_stretch(wc_topology *t, const double *xyz, const int32_t 
                                int32_t face_count, int32_t face_size, const int32_t *corners,
                                const double *face_area)
 {
-    link_entry *e = wc_alloc_array((size_t)face_count * 6, sizeof *e);
+    link_entry *e = wci_alloc_array((size_t)face_count * 6, sizeof *e);
     if (!e) return WC_ERROR_OUT_OF_MEMORY;
     size_t count = 0;
     for (int32_t f = 0; f < face_count; ++f) {
@@ -168,7 +168,7 @@ static wc_status build_stretch(wc_topology *t, const double *xyz, const int32_t 
         }
     }
     wc_status s = merge_entries(e, count, xyz, &t->stretch);
-    wc_free(e);
+    wci_free(e);
     return s;
 }
 
@@ -176,13 +176,13 @@ static wc_status build_stretch(wc_topology *t, const double *xyz, const int32_t 
 static wc_status neighbours(const wc_link_set *links, int32_t n, int32_t **start_out,
                             int32_t **list_out)
 {
-    int32_t *start = wc_alloc_array((size_t)n + 1, sizeof *start);
-    int32_t *list = wc_alloc_array((size_t)links->count * 2, sizeof *list);
-    int32_t *fill = wc_alloc_array((size_t)n, sizeof *fill);
+    int32_t *start = wci_alloc_array((size_t)n + 1, sizeof *start);
+    int32_t *list = wci_alloc_array((size_t)links->count * 2, sizeof *list);
+    int32_t *fill = wci_alloc_array((size_t)n, sizeof *fill);
     if (!start || !list || !fill) {
-        wc_free(start);
-        wc_free(list);
-        wc_free(fill);
+        wci_free(start);
+        wci_free(list);
+        wci_free(fill);
         return WC_ERROR_OUT_OF_MEMORY;
     }
     for (int32_t e = 0; e < links->count; ++e) {
@@ -195,7 +195,7 @@ static wc_status neighbours(const wc_link_set *links, int32_t n, int32_t **start
         list[start[a] + fill[a]++] = b;
         list[start[b] + fill[b]++] = a;
     }
-    wc_free(fill);
+    wci_free(fill);
     *start_out = start;
     *list_out = list;
     return WC_OK;
@@ -245,7 +245,7 @@ static wc_status build_bend(wc_topology *t, const double *xyz)
     int32_t n = t->particle_count, *start, *list;
     wc_status s = neighbours(&t->stretch, n, &start, &list);
     if (s) return s;
-    link_entry *e = wc_alloc_array((size_t)start[n], sizeof *e);
+    link_entry *e = wci_alloc_array((size_t)start[n], sizeof *e);
     size_t count = 0;
     if (!e) s = WC_ERROR_OUT_OF_MEMORY;
     for (int32_t b = 0; b < n && !s; ++b)
@@ -255,12 +255,12 @@ static wc_status build_bend(wc_topology *t, const double *xyz)
                 add_entry(e, &count, a, c, 0.0);
         }
     if (!s) s = merge_entries(e, count, xyz, &t->bend);
-    wc_free(e);
-    wc_free(start);
-    wc_free(list);
+    wci_free(e);
+    wci_free(start);
+    wci_free(list);
     if (s) return s;
     /* Each particle's area is shared equally among its bend links. */
-    int32_t *degree = wc_alloc_array((size_t)n, sizeof *degree);
+    int32_t *degree = wci_alloc_array((size_t)n, sizeof *degree);
     if (!degree) return WC_ERROR_OUT_OF_MEMORY;
     for (int32_t k = 0; k < t->bend.count; ++k) {
         degree[t->bend.a[k]]++;
@@ -269,7 +269,7 @@ static wc_status build_bend(wc_topology *t, const double *xyz)
     for (int32_t k = 0; k < t->bend.count; ++k)
         t->bend.share[k] = t->area[t->bend.a[k]] / degree[t->bend.a[k]] +
                            t->area[t->bend.b[k]] / degree[t->bend.b[k]];
-    wc_free(degree);
+    wci_free(degree);
     return WC_OK;
 }
 
@@ -290,20 +290,20 @@ static void build_triangles(wc_topology *t, const int32_t *faces, int32_t face_c
     }
 }
 
-wc_status wc_topology_build(wc_topology *t, const double *xyz, int32_t n, const int32_t *faces,
+wc_status wci_topology_create(wc_topology *t, const double *xyz, int32_t n, const int32_t *faces,
                             int32_t face_count, int32_t face_size, wc_message *msg)
 {
     memset(t, 0, sizeof *t);
     t->particle_count = n;
-    long bad = wc_first_non_finite(xyz, 3L * n);
+    long bad = wci_first_non_finite(xyz, 3L * n);
     if (bad >= 0)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "cloth vertex %ld has a non-finite coordinate (%c = %g)", bad / 3,
                        "xyz"[bad % 3], xyz[bad]);
 
-    int32_t *corners = wc_alloc_array((size_t)face_count, sizeof *corners);
-    double *face_area = wc_alloc_array((size_t)face_count, sizeof *face_area);
-    t->area = wc_alloc_array((size_t)n, sizeof *t->area);
+    int32_t *corners = wci_alloc_array((size_t)face_count, sizeof *corners);
+    double *face_area = wci_alloc_array((size_t)face_count, sizeof *face_area);
+    t->area = wci_alloc_array((size_t)n, sizeof *t->area);
     wc_status s = (corners && face_area && t->area) ? WC_OK : WC_ERROR_OUT_OF_MEMORY;
     int32_t triangles = 0;
     for (int32_t f = 0; f < face_count && !s; ++f) {
@@ -315,31 +315,31 @@ wc_status wc_topology_build(wc_topology *t, const double *xyz, int32_t n, const 
     }
     for (int32_t i = 0; i < n && !s; ++i)
         if (t->area[i] == 0.0)
-            s = wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            s = wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                         "cloth vertex %d belongs to no face (every vertex needs a face to have mass)",
                         (int)i);
     if (!s) s = build_stretch(t, xyz, faces, face_count, face_size, corners, face_area);
     if (!s) s = build_bend(t, xyz);
     if (!s) {
         t->triangle_count = triangles;
-        t->triangles = wc_alloc_array((size_t)triangles * 3, sizeof *t->triangles);
+        t->triangles = wci_alloc_array((size_t)triangles * 3, sizeof *t->triangles);
         if (t->triangles) build_triangles(t, faces, face_count, face_size, corners);
         else s = WC_ERROR_OUT_OF_MEMORY;
     }
-    wc_free(corners);
-    wc_free(face_area);
+    wci_free(corners);
+    wci_free(face_area);
     if (s == WC_ERROR_OUT_OF_MEMORY)
-        wc_fail(msg, s, "out of memory while building the topology of a cloth of %d vertices",
+        wci_fail(msg, s, "out of memory while building the topology of a cloth of %d vertices",
                 (int)n);
-    if (s) wc_topology_free(t);
+    if (s) wci_topology_destroy(t);
     return s;
 }
 
-void wc_topology_free(wc_topology *t)
+void wci_topology_destroy(wc_topology *t)
 {
-    wc_free(t->area);
+    wci_free(t->area);
     link_set_free(&t->stretch);
     link_set_free(&t->bend);
-    wc_free(t->triangles);
+    wci_free(t->triangles);
     memset(t, 0, sizeof *t);
 }

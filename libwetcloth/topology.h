@@ -36,11 +36,11 @@ typedef struct wc_topology {
 /// Builds the topology of a mesh. Validates everything: finite vertices,
 /// indices in range, no face using a vertex twice, no degenerate face, no
 /// vertex outside every face. On failure nothing is allocated.
-wc_status wc_topology_build(wc_topology *out, const double *xyz, int32_t vertex_count,
+wc_status wci_topology_create(wc_topology *out, const double *xyz, int32_t vertex_count,
                             const int32_t *faces, int32_t face_count, int32_t face_size,
                             wc_message *msg);
 
-void wc_topology_free(wc_topology *topology);
+void wci_topology_destroy(wc_topology *topology);
 
 /// The rest angle a-b-c counts as "nearly straight" when its cosine is at most
 /// this: cos(150 degrees), with a little slack so exact 150 degrees qualifies.

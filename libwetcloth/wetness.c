@@ -24,7 +24,7 @@
  *    pulls (thesis Fig. 3.5).
  * Each particle sums its own pulls, so the loop is parallel and the result
  * the same for any thread count. */
-void wc_wet_forces(wc_cloth *c, int threads)
+void wci_wet_forces(wc_cloth *c, int threads)
 {
     int32_t n = c->particle_count, stretch_count = c->topology.stretch.count;
     const wc_material *m = &c->material;
@@ -64,7 +64,7 @@ void wc_wet_forces(wc_cloth *c, int threads)
         c->fy[i] += f[1];
         c->fz[i] += f[2];
     }
-    if (c->adhesive_count) wc_wet_self_adhesion(c, c->fx, c->fy, c->fz);
+    if (c->adhesive_count) wci_wet_self_adhesion(c, c->fx, c->fy, c->fz);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -89,20 +89,20 @@ void wc_wet_forces(wc_cloth *c, int threads)
  * closer than 2 h in the rest shape) never adhere: they are the cloth
  * itself, not a second layer. Between different cloths of a group the same
  * law acts on the pairs the group's collision answered (cloth_group.c),
- * with each side's own adhesion and wetness (wc_wet_pair_adhesion). */
+ * with each side's own adhesion and wetness (wci_wet_pair_adhesion). */
 
-void wc_wet_note_self_contact(wc_cloth *c, int32_t v, int32_t t)
+void wci_wet_note_self_contact(wc_cloth *c, int32_t v, int32_t t)
 {
     if (c->self_touched_count == c->self_touched_capacity) {
         int64_t capacity = c->self_touched_capacity ? 2 * c->self_touched_capacity : 256;
-        int32_t *grown = wc_alloc_array((size_t)capacity, 2 * sizeof *grown);
+        int32_t *grown = wci_alloc_array((size_t)capacity, 2 * sizeof *grown);
         if (!grown) {
             c->self_touched_failed = 1;
             return;
         }
         if (c->self_touched_count)
             memcpy(grown, c->self_touched, (size_t)c->self_touched_count * 2 * sizeof *grown);
-        wc_free(c->self_touched);
+        wci_free(c->self_touched);
         c->self_touched = grown;
         c->self_touched_capacity = capacity;
     }
@@ -119,7 +119,7 @@ static int compare_pair(const void *pa, const void *pb)
     return 0;
 }
 
-wc_status wc_wet_self_pairs(wc_cloth *c, double h)
+wc_status wci_wet_self_pairs(wc_cloth *c, double h)
 {
     int64_t old = c->adhesive_count, total = c->self_touched_count + old;
     if (c->self_touched_failed) {
@@ -128,11 +128,11 @@ wc_status wc_wet_self_pairs(wc_cloth *c, double h)
     }
     if (total == 0) return WC_OK;
     /* the answered pairs and last step's adhesive ones, sorted, unique */
-    int32_t *keys = wc_alloc_array((size_t)total, 2 * sizeof *keys);
-    int32_t *pairs = total > c->adhesive_capacity ? wc_alloc_array((size_t)total, 2 * sizeof *pairs) : NULL;
-    double *data = total > c->adhesive_capacity ? wc_alloc_array((size_t)total, 6 * sizeof *data) : NULL;
+    int32_t *keys = wci_alloc_array((size_t)total, 2 * sizeof *keys);
+    int32_t *pairs = total > c->adhesive_capacity ? wci_alloc_array((size_t)total, 2 * sizeof *pairs) : NULL;
+    double *data = total > c->adhesive_capacity ? wci_alloc_array((size_t)total, 6 * sizeof *data) : NULL;
     if (!keys || (total > c->adhesive_capacity && (!pairs || !data))) {
-        wc_free(keys), wc_free(pairs), wc_free(data);
+        wci_free(keys), wci_free(pairs), wci_free(data);
         c->self_touched_count = 0;
         return WC_ERROR_OUT_OF_MEMORY;
     }
@@ -141,7 +141,7 @@ wc_status wc_wet_self_pairs(wc_cloth *c, double h)
     if (old) memcpy(keys + 2 * c->self_touched_count, c->adhesive_pairs, (size_t)old * 2 * sizeof *keys);
     c->self_touched_count = 0;
     if (pairs) {
-        wc_free(c->adhesive_pairs), wc_free(c->adhesive_data);
+        wci_free(c->adhesive_pairs), wci_free(c->adhesive_data);
         c->adhesive_pairs = pairs, c->adhesive_data = data, c->adhesive_capacity = total;
     }
     qsort(keys, (size_t)total, 2 * sizeof *keys, compare_pair);
@@ -155,7 +155,7 @@ wc_status wc_wet_self_pairs(wc_cloth *c, double h)
         double p[3] = {c->nx[v], c->ny[v], c->nz[v]}, corner[3][3], w[3], n[3];
         for (int j = 0; j < 3; ++j)
             corner[j][0] = c->nx[tri[j]], corner[j][1] = c->ny[tri[j]], corner[j][2] = c->nz[tri[j]];
-        double d2 = wc_point_triangle_closest(p, corner[0], corner[1], corner[2], w);
+        double d2 = wci_point_triangle_closest(p, corner[0], corner[1], corner[2], w);
         if (!(d2 < reach * reach) || !(d2 > 0.0)) continue; /* parted, or no direction */
         double d = sqrt(d2);
         for (int j = 0; j < 3; ++j) n[j] = (p[j] - (w[0] * corner[0][j] + w[1] * corner[1][j] + w[2] * corner[2][j])) / d;
@@ -165,14 +165,14 @@ wc_status wc_wet_self_pairs(wc_cloth *c, double h)
         ++kept;
     }
     c->adhesive_count = kept;
-    wc_free(keys);
+    wci_free(keys);
     return WC_OK;
 }
 
-void wc_wet_self_adhesion(const wc_cloth *c, double *fx, double *fy, double *fz)
+void wci_wet_self_adhesion(const wc_cloth *c, double *fx, double *fy, double *fz)
 {
     wc_wet_piece whole = {c->wetness, c->topology.area, c->material.adhesion, fx, fy, fz, 0};
-    wc_wet_pair_adhesion(c->adhesive_pairs, c->adhesive_data, c->adhesive_count,
+    wci_wet_pair_adhesion(c->adhesive_pairs, c->adhesive_data, c->adhesive_count,
                          c->topology.triangles, &whole, 1);
 }
 
@@ -195,7 +195,7 @@ static const wc_wet_piece *piece_of(const wc_wet_piece *pieces, int32_t count, i
  * cloth a is the same on both sides and this is a max(w_v, w_f), the rule
  * above; no combination (mean, product) keeps both that and the collider
  * case. */
-void wc_wet_pair_adhesion(const int32_t *pairs, const double *data, int64_t count,
+void wci_wet_pair_adhesion(const int32_t *pairs, const double *data, int64_t count,
                           const int32_t *triangles, const wc_wet_piece *pieces,
                           int32_t piece_count)
 {
@@ -261,11 +261,11 @@ static int mesh_nearest(const wc_collider *col, const double p[3], double reach,
     if (!wc_boxes_overlap(box, col->bounds)) return 0;
     enum { CAPACITY = 256 };
     int32_t stack[CAPACITY], *found = stack;
-    int32_t count = wc_bvh_query(&col->bvh, box, stack, CAPACITY);
+    int32_t count = wci_bvh_query(&col->bvh, box, stack, CAPACITY);
     if (count > CAPACITY) {
-        found = wc_alloc_array((size_t)count, sizeof *found);
+        found = wci_alloc_array((size_t)count, sizeof *found);
         if (!found) return 0; /* no room to look: the contact is not held */
-        wc_bvh_query(&col->bvh, box, found, count);
+        wci_bvh_query(&col->bvh, box, found, count);
     }
     double best = reach * reach, offset[3] = {0.0, 0.0, 0.0};
     int hit = 0;
@@ -274,15 +274,15 @@ static int mesh_nearest(const wc_collider *col, const double p[3], double reach,
         const double *a = col->next + 3 * (size_t)v[0], *b = col->next + 3 * (size_t)v[1],
                      *c = col->next + 3 * (size_t)v[2];
         double nrm[3];
-        wc_triangle_normal(a, b, c, nrm);
+        wci_triangle_normal(a, b, c, nrm);
         if (nrm[0] == 0.0 && nrm[1] == 0.0 && nrm[2] == 0.0) continue; /* degenerate: ignored */
         double w[3];
-        double d2 = wc_point_triangle_closest(p, a, b, c, w);
+        double d2 = wci_point_triangle_closest(p, a, b, c, w);
         if (!(d2 < best)) continue;
         best = d2, hit = 1;
         for (int j = 0; j < 3; ++j) offset[j] = p[j] - (w[0] * a[j] + w[1] * b[j] + w[2] * c[j]);
     }
-    if (found != stack) wc_free(found);
+    if (found != stack) wci_free(found);
     double len = sqrt(best);
     if (!hit || !(len > 0.0)) return 0;
     for (int j = 0; j < 3; ++j) n[j] = offset[j] / len;
@@ -297,15 +297,15 @@ static int convex_nearest(const wc_collider *col, const double p[3], double reac
     double local[3], depth, dir[3], out[3];
     for (int k = 0; k < 3; ++k)
         if (p[k] < col->bounds[k] - reach || p[k] > col->bounds[k + 3] + reach) return 0;
-    wc_pose_to_local(&col->pose_next, p, local);
-    if (!wc_convex_penetration(&col->convex, local, reach, &depth, dir)) return 0;
+    wci_pose_to_local(&col->pose_next, p, local);
+    if (!wci_convex_penetration(&col->convex, local, reach, &depth, dir)) return 0;
     for (int k = 0; k < 3; ++k) out[k] = -dir[k];
-    wc_pose_rotate(&col->pose_next, out, n);
+    wci_pose_rotate(&col->pose_next, out, n);
     *dist = reach - depth;
     return 1;
 }
 
-void wc_wet_hold_contacts(wc_cloth *c, wc_collider *const *colliders, int32_t count, int threads)
+void wci_wet_hold_contacts(wc_cloth *c, wc_collider *const *colliders, int32_t count, int threads)
 {
     int32_t n = c->particle_count;
     double h = c->material.thickness;
@@ -334,7 +334,7 @@ void wc_wet_hold_contacts(wc_cloth *c, wc_collider *const *colliders, int32_t co
     }
 }
 
-int32_t wc_wet_mark_stuck(wc_cloth *c)
+int32_t wci_wet_mark_stuck(wc_cloth *c)
 {
     int32_t stuck = 0;
     int adhesive = c->material.adhesion > 0.0;
@@ -354,7 +354,7 @@ int32_t wc_wet_mark_stuck(wc_cloth *c)
  * exact for dw/dt = -rate w. */
 #define WICKING_MAX_SUBSTEPS 64
 
-void wc_wet_update(wc_cloth *c, double dt)
+void wci_wet_update(wc_cloth *c, double dt)
 {
     const wc_material *m = &c->material;
     const wc_link_set *links = &c->topology.stretch;
@@ -404,5 +404,5 @@ void wc_wet_update(wc_cloth *c, double dt)
         double keep = exp(-m->drying * dt);
         for (int32_t i = 0; i < n; ++i) c->wetness[i] *= keep;
     }
-    wc_cloth_apply_material(c);
+    wci_cloth_apply_material(c);
 }

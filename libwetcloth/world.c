@@ -69,31 +69,31 @@ static wc_status validate_world_def(const wc_world_def *d, wc_message *msg)
 {
     for (int k = 0; k < 3; ++k)
         if (!isfinite(d->gravity[k]))
-            return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                            "world_def.gravity[%d] must be finite but is %g", k, d->gravity[k]);
     if (d->thread_count < 0 || d->thread_count > 1024)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.thread_count must be in [0, 1024] (0 = OpenMP default) but is %d",
                        (int)d->thread_count);
     if (d->integrator != WC_INTEGRATOR_VERLET && d->integrator != WC_INTEGRATOR_XPBD &&
         d->integrator != WC_INTEGRATOR_IMPLICIT)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.integrator must be WC_INTEGRATOR_VERLET (0), "
                        "WC_INTEGRATOR_XPBD (1) or WC_INTEGRATOR_IMPLICIT (2) but is %d",
                        (int)d->integrator);
     if (!(d->substep_safety > 0.0 && d->substep_safety <= 1.0))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.substep_safety must be in (0, 1] but is %g", d->substep_safety);
     if (d->max_substeps < 1 || d->max_substeps > 10000000)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.max_substeps must be in [1, 10000000] but is %d",
                        (int)d->max_substeps);
     if (!(d->implicit_tolerance >= 0.0 && d->implicit_tolerance <= 1000.0))
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.implicit_tolerance must be in [0, 1000] m/s^2 but is %g",
                        d->implicit_tolerance);
     if (d->adapt_threads != 0 && d->adapt_threads != 1)
-        return wc_fail(msg, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(msg, WC_ERROR_INVALID_ARGUMENT,
                        "world_def.adapt_threads must be 0 or 1 but is %d", (int)d->adapt_threads);
     return WC_OK;
 }
@@ -102,16 +102,16 @@ wc_status wc_world_create(const wc_world_def *def, wc_world **out_world, wc_mess
 {
     if (out_message) out_message->text[0] = '\0';
     if (!out_world)
-        return wc_fail(out_message, WC_ERROR_INVALID_ARGUMENT, "wc_world_create: out_world is NULL");
+        return wci_fail(out_message, WC_ERROR_INVALID_ARGUMENT, "wc_world_create: out_world is NULL");
     *out_world = NULL;
     if (!def)
-        return wc_fail(out_message, WC_ERROR_INVALID_ARGUMENT, "wc_world_create: def is NULL");
+        return wci_fail(out_message, WC_ERROR_INVALID_ARGUMENT, "wc_world_create: def is NULL");
     wc_status s = validate_world_def(def, out_message);
     if (s) return s;
-    wc_world *w = wc_alloc_array(1, sizeof *w);
-    if (!w) return wc_fail(out_message, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a world");
+    wc_world *w = wci_alloc_array(1, sizeof *w);
+    if (!w) return wci_fail(out_message, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a world");
     w->def = *def;
-    wc_thread_tuner_create(&w->tuner, wc_thread_count(def->thread_count), def->adapt_threads);
+    wci_thread_tuner_create(&w->tuner, wci_thread_count(def->thread_count), def->adapt_threads);
     *out_world = w;
     return WC_OK;
 }
@@ -119,23 +119,23 @@ wc_status wc_world_create(const wc_world_def *def, wc_world **out_world, wc_mess
 void wc_world_destroy(wc_world *w)
 {
     if (!w) return;
-    for (int32_t i = 0; i < w->cloth_count; ++i) wc_cloth_destroy(w->cloths[i]);
-    for (int32_t i = 0; i < w->collider_count; ++i) wc_collider_destroy(w->colliders[i]);
-    wc_free(w->cloths);
-    wc_free(w->colliders);
-    wc_contact_backup_free(&w->backup);
-    wc_cloth_group_destroy(w->group);
-    wc_free(w);
+    for (int32_t i = 0; i < w->cloth_count; ++i) wci_cloth_destroy(w->cloths[i]);
+    for (int32_t i = 0; i < w->collider_count; ++i) wci_collider_destroy(w->colliders[i]);
+    wci_free(w->cloths);
+    wci_free(w->colliders);
+    wci_contact_backup_destroy(&w->backup);
+    wci_cloth_group_destroy(w->group);
+    wci_free(w);
 }
 
-wc_message *wc_world_message(const wc_world *w) { return (wc_message *)&w->error; }
+wc_message *wci_world_message(const wc_world *w) { return (wc_message *)&w->error; }
 
 const char *wc_world_last_error(const wc_world *w) { return w ? w->error.text : "world is NULL"; }
 
-wc_cloth *wc_world_find_cloth(const wc_world *w, int32_t cloth, const char *caller)
+wc_cloth *wci_world_find_cloth(const wc_world *w, int32_t cloth, const char *caller)
 {
     if (cloth >= 0 && cloth < w->cloth_count) return w->cloths[cloth];
-    wc_fail(wc_world_message(w), WC_ERROR_NOT_FOUND, "%s: cloth %d does not exist (the world has %d)",
+    wci_fail(wci_world_message(w), WC_ERROR_NOT_FOUND, "%s: cloth %d does not exist (the world has %d)",
             caller, (int)cloth, (int)w->cloth_count);
     return NULL;
 }
@@ -148,13 +148,13 @@ static int any_cloth_collision(const wc_world *w)
 {
     for (int32_t c = 0; c < w->cloth_count; ++c)
         if (w->cloths[c]->self) return 1;
-    return wc_cloth_group_possible(w->cloths, w->cloth_count);
+    return wci_cloth_group_possible(w->cloths, w->cloth_count);
 }
 
 static wc_status non_finite_error(wc_world *w, double dt, int32_t cloth, int32_t particle,
                                   const char *phase)
 {
-    return wc_fail(&w->error, WC_ERROR_NON_FINITE,
+    return wci_fail(&w->error, WC_ERROR_NON_FINITE,
                    "step of %g s would move particle %d of cloth %d to a non-finite position "
                    "(in %s); the stable step is about %g s. The world keeps its last good state",
                    dt, (int)particle, (int)cloth, phase, w->cloths[cloth]->stable_dt);
@@ -170,9 +170,9 @@ static wc_status guard_steps(wc_world *w, double dt, int threads)
     if (w->def.integrator != WC_INTEGRATOR_VERLET) return WC_OK;
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_cloth *cl = w->cloths[c];
-        int32_t p = wc_step_guard_check(cl, &cl->guard, dt, threads, &cl->guard_next);
+        int32_t p = wci_step_guard_check(cl, &cl->guard, dt, threads, &cl->guard_next);
         if (p >= 0)
-            return wc_fail(&w->error, WC_ERROR_NON_FINITE,
+            return wci_fail(&w->error, WC_ERROR_NON_FINITE,
                            "step of %g s is unstable: particle %d of cloth %d oscillates with an "
                            "amplitude that grew %.3g-fold over the last %d steps (the stable step "
                            "is about %g s). The world keeps its last good state; take shorter "
@@ -190,8 +190,8 @@ static wc_status guard_steps(wc_world *w, double dt, int threads)
 static wc_status collide(wc_world *w, double dt, double share, int32_t steps_left, int threads)
 {
     for (int32_t k = 0; k < w->collider_count; ++k)
-        if (wc_collider_begin_step(w->colliders[k], share))
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+        if (wci_collider_begin_step(w->colliders[k], share))
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory indexing collider %d; the world keeps its last good state",
                            (int)k);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
@@ -202,40 +202,40 @@ static wc_status collide(wc_world *w, double dt, double share, int32_t steps_lef
         memset(cl->contact, 0, (size_t)cl->particle_count);
         memset(cl->history_override, 0, (size_t)cl->particle_count);
         if (!w->collider_count) continue;
-        if (!cl->collider_contacts && !(cl->collider_contacts = wc_collider_contacts_create(cl)))
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+        if (!cl->collider_contacts && !(cl->collider_contacts = wci_collider_contacts_create(cl)))
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory for the collision buffers of cloth %d; the world "
                            "keeps its last good state", (int)c);
-        if (wc_collider_contacts_resolve(cl, cl->collider_contacts, w->colliders, w->collider_count,
+        if (wci_collider_contacts_resolve(cl, cl->collider_contacts, w->colliders, w->collider_count,
                                          steps_left, threads, &w->stats))
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory indexing cloth %d for collisions; the world keeps its "
                            "last good state", (int)c);
         /* before self-collision, which must see held particles as resting
          * on their collider */
-        if (cl->wet_forces) wc_wet_hold_contacts(cl, w->colliders, w->collider_count, threads);
+        if (cl->wet_forces) wci_wet_hold_contacts(cl, w->colliders, w->collider_count, threads);
     }
     /* cloths against each other, after all their collider passes */
-    if (wc_cloth_group_sync(&w->group, w->cloths, w->cloth_count) ||
-        (w->group && wc_cloth_group_collide(w->group, w->cloths, dt, threads, &w->stats)))
-        return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+    if (wci_cloth_group_update(&w->group, w->cloths, w->cloth_count) ||
+        (w->group && wci_cloth_group_collide(w->group, w->cloths, dt, threads, &w->stats)))
+        return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                        "out of memory in the collision between cloths; the world keeps its last "
                        "good state");
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_cloth *cl = w->cloths[c];
-        int alone = !wc_cloth_group_handled(w->group, c);
-        if (alone && cl->self && wc_self_collide(cl, dt, threads, &w->stats))
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+        int alone = !wci_cloth_group_handled(w->group, c);
+        if (alone && cl->self && wci_self_collide(cl, dt, threads, &w->stats))
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory in the self-collision of cloth %d; the world keeps its "
                            "last good state", (int)c);
-        if (alone && cl->self && cl->wet_forces && wc_wet_self_pairs(cl, wc_self_thickness(cl)))
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+        if (alone && cl->self && cl->wet_forces && wci_wet_self_pairs(cl, wci_self_thickness(cl)))
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory for the self-adhesion of cloth %d; the world keeps its "
                            "last good state", (int)c);
         long bad = -1;
         for (int axis = 0; axis < 3 && bad < 0; ++axis) {
             const double *v = axis == 0 ? cl->nx : axis == 1 ? cl->ny : cl->nz;
-            bad = wc_first_non_finite(v, cl->particle_count);
+            bad = wci_first_non_finite(v, cl->particle_count);
         }
         if (bad >= 0) return non_finite_error(w, dt, c, (int32_t)bad, "collision response");
         /* counted once at the end: the passes above may visit a particle
@@ -255,19 +255,19 @@ static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_f
     int32_t bad;
     switch (w->def.integrator) {
     case WC_INTEGRATOR_XPBD:
-        if (!cl->xpbd && !(cl->xpbd = wc_xpbd_state_create(cl))) break;
-        bad = wc_integrate_xpbd(cl, dt, pin_fraction, threads);
+        if (!cl->xpbd && !(cl->xpbd = wci_xpbd_state_create(cl))) break;
+        bad = wci_integrate_xpbd(cl, dt, pin_fraction, threads);
         return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
     case WC_INTEGRATOR_IMPLICIT:
-        if (!cl->implicit && !(cl->implicit = wc_implicit_state_create(cl))) break;
-        bad = wc_integrate_implicit(cl, dt, pin_fraction, w->def.implicit_tolerance, threads);
-        w->solver_iterations += wc_implicit_last_iterations(cl->implicit);
+        if (!cl->implicit && !(cl->implicit = wci_implicit_state_create(cl))) break;
+        bad = wci_integrate_implicit(cl, dt, pin_fraction, w->def.implicit_tolerance, threads);
+        w->solver_iterations += wci_implicit_last_iterations(cl->implicit);
         return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
     default:
-        bad = wc_integrate_verlet(cl, dt, pin_fraction, threads);
+        bad = wci_integrate_verlet(cl, dt, pin_fraction, threads);
         return bad >= 0 ? non_finite_error(w, dt, c, bad, "integration") : WC_OK;
     }
-    return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+    return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                    "out of memory for the integrator buffers of cloth %d; the world keeps its "
                    "last good state", (int)c);
 }
@@ -283,59 +283,59 @@ static wc_status integrate_cloth(wc_world *w, int32_t c, double dt, double pin_f
 static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_left,
                             double pin_start, double pin_fraction)
 {
-    int threads = wc_thread_tuner_threads(&w->tuner);
+    int threads = wci_thread_tuner_threads(&w->tuner);
     memset(&w->stats, 0, sizeof w->stats);
     w->stats.threads = threads;
-    double *phase = w->phase_seconds, t0 = wc_clock_seconds(), t1;
+    double *phase = w->phase_seconds, t0 = wci_clock_seconds(), t1;
     /* soft pins pull toward where their targets are when the integrator
      * evaluates forces: the step's start, or its end for backward Euler */
     double goal_fraction = w->def.integrator == WC_INTEGRATOR_IMPLICIT ? pin_fraction : pin_start;
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_cloth *cl = w->cloths[c];
-        wc_forces_compute(cl, w->def.gravity, threads);
-        if (wc_applied_active(cl)) wc_applied_forces_add(cl, goal_fraction, threads);
-        if (cl->wet_forces) wc_wet_forces(cl, threads);
+        wci_forces_compute(cl, w->def.gravity, threads);
+        if (wci_applied_active(cl)) wci_applied_forces_add(cl, goal_fraction, threads);
+        if (cl->wet_forces) wci_wet_forces(cl, threads);
     }
     /* wet cloths sticking to each other: after every cloth's own forces */
-    wc_cloth_group_adhesion(w->group, w->cloths);
-    t1 = wc_clock_seconds(), phase[0] += t1 - t0, t0 = t1;
+    wci_cloth_group_adhesion(w->group, w->cloths);
+    t1 = wci_clock_seconds(), phase[0] += t1 - t0, t0 = t1;
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_status s = integrate_cloth(w, c, dt, pin_fraction, threads);
         if (s) return s;
     }
     wc_status s = guard_steps(w, dt, threads);
     if (s) return s;
-    t1 = wc_clock_seconds(), phase[1] += t1 - t0, t0 = t1;
+    t1 = wci_clock_seconds(), phase[1] += t1 - t0, t0 = t1;
     int colliding = w->collider_count > 0 || any_cloth_collision(w);
     if (colliding) {
         /* collision changes contacts before it knows it will succeed: a
          * failed step puts them back (contact_backup.h) */
-        if (wc_contact_backup_save(&w->backup, w->cloths, w->cloth_count) ||
-            wc_cloth_group_save(w->group))
-            return wc_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+        if (wci_contact_backup_save(&w->backup, w->cloths, w->cloth_count) ||
+            wci_cloth_group_save(w->group))
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory saving the contact state; the world keeps its last "
                            "good state");
         s = collide(w, dt, share, steps_left, threads);
         if (s) {
-            wc_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
-            wc_cloth_group_restore(w->group);
+            wci_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
+            wci_cloth_group_restore(w->group);
             return s;
         }
     }
-    t1 = wc_clock_seconds(), phase[2] += t1 - t0, t0 = t1;
+    t1 = wci_clock_seconds(), phase[2] += t1 - t0, t0 = t1;
     if (colliding)
         for (int32_t c = 0; c < w->cloth_count; ++c)
-            w->stats.stuck_particles += wc_wet_mark_stuck(w->cloths[c]);
+            w->stats.stuck_particles += wci_wet_mark_stuck(w->cloths[c]);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
-        wc_cloth_commit(w->cloths[c], dt, colliding);
+        wci_cloth_commit(w->cloths[c], dt, colliding);
         w->cloths[c]->guard = w->cloths[c]->guard_next;
     }
-    for (int32_t k = 0; k < w->collider_count; ++k) wc_collider_end_step(w->colliders[k]);
+    for (int32_t k = 0; k < w->collider_count; ++k) wci_collider_end_step(w->colliders[k]);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         const wc_material *m = &w->cloths[c]->material;
-        if (m->wicking > 0.0 || m->drying > 0.0) wc_wet_update(w->cloths[c], dt);
+        if (m->wicking > 0.0 || m->drying > 0.0) wci_wet_update(w->cloths[c], dt);
     }
-    phase[3] += wc_clock_seconds() - t0;
+    phase[3] += wci_clock_seconds() - t0;
     w->time += dt;
     return WC_OK;
 }
@@ -345,9 +345,9 @@ static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_
 static wc_status timed_step(wc_world *w, double dt, double share, int32_t steps_left,
                             double pin_start, double pin_fraction)
 {
-    double start = wc_clock_seconds();
+    double start = wci_clock_seconds();
     wc_status s = world_step(w, dt, share, steps_left, pin_start, pin_fraction);
-    wc_thread_tuner_record(&w->tuner, wc_clock_seconds() - start);
+    wci_thread_tuner_record(&w->tuner, wci_clock_seconds() - start);
     return s;
 }
 
@@ -383,7 +383,7 @@ static void settle_pins(wc_world *w, double reached)
             double *from = cl->pins.from + 3 * (size_t)p;
             if (cl->pins.stiffness && cl->pins.stiffness[p] > 0.0) {
                 double target[3];
-                wc_pinned_position(cl, p, reached, target);
+                wci_pinned_position(cl, p, reached, target);
                 from[0] = target[0], from[1] = target[1], from[2] = target[2];
                 continue;
             }
@@ -397,7 +397,7 @@ static void settle_pins(wc_world *w, double reached)
 static wc_status check_step_length(wc_world *w, const char *name, double dt)
 {
     if (!(isfinite(dt) && dt > 0.0 && dt <= 10.0))
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "%s must be in (0, 10] s but is %g",
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT, "%s must be in (0, 10] s but is %g",
                        name, dt);
     return WC_OK;
 }
@@ -429,13 +429,13 @@ wc_status wc_world_advance(wc_world *w, double frame_dt, int32_t substeps)
     wc_status s = check_step_length(w, "wc_world_advance: frame_dt", frame_dt);
     if (s) return s;
     if (substeps < 0 || substeps > w->def.max_substeps)
-        return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+        return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                        "wc_world_advance: substeps must be in [0, %d] (0 = automatic) but is %d",
                        (int)w->def.max_substeps, (int)substeps);
     if (substeps == 0) {
         double needed = ceil(frame_dt / (w->def.substep_safety * wc_world_stable_dt(w)));
         if (needed > w->def.max_substeps)
-            return wc_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
+            return wci_fail(&w->error, WC_ERROR_INVALID_ARGUMENT,
                            "wc_world_advance: a frame of %g s needs %.0f substeps at the stable "
                            "step %g s, more than world_def.max_substeps = %d",
                            frame_dt, needed, wc_world_stable_dt(w), (int)w->def.max_substeps);

@@ -38,9 +38,9 @@ struct wc_world {
 };
 
 /// The world's message buffer, writable from const entry points.
-wc_message *wc_world_message(const wc_world *world);
+wc_message *wci_world_message(const wc_world *world);
 
 /// The cloth at an index, or NULL after reporting WC_ERROR_NOT_FOUND.
-wc_cloth *wc_world_find_cloth(const wc_world *world, int32_t cloth, const char *caller);
+wc_cloth *wci_world_find_cloth(const wc_world *world, int32_t cloth, const char *caller);
 
 #endif

@@ -42,18 +42,18 @@ struct wc_xpbd_state {
 
 static void free_colors(link_colors *lc)
 {
-    wc_free(lc->links);
-    wc_free(lc->lambda);
+    wci_free(lc->links);
+    wci_free(lc->lambda);
 }
 
 /* Greedy colouring of one link set; links ascending within a colour, so
  * the order is fixed by the mesh alone. Returns 0 when out of memory. */
 static int color_links(const wc_link_set *s, int32_t particles, link_colors *lc)
 {
-    uint64_t *used = wc_alloc_array((size_t)particles, sizeof *used);
-    uint8_t *color = wc_alloc_array((size_t)s->count + 1, sizeof *color);
-    lc->links = wc_alloc_array((size_t)s->count + 1, sizeof *lc->links);
-    lc->lambda = wc_alloc_array((size_t)s->count + 1, sizeof *lc->lambda);
+    uint64_t *used = wci_alloc_array((size_t)particles, sizeof *used);
+    uint8_t *color = wci_alloc_array((size_t)s->count + 1, sizeof *color);
+    lc->links = wci_alloc_array((size_t)s->count + 1, sizeof *lc->links);
+    lc->lambda = wci_alloc_array((size_t)s->count + 1, sizeof *lc->lambda);
     int ok = used && color && lc->links && lc->lambda;
     if (ok) {
         int32_t count[GREEDY_COLORS + 1] = {0};
@@ -81,30 +81,30 @@ static int color_links(const wc_link_set *s, int32_t particles, link_colors *lc)
         lc->color_start[colors] = start;
         lc->color_count = colors;
     }
-    wc_free(used);
-    wc_free(color);
+    wci_free(used);
+    wci_free(color);
     return ok;
 }
 
-wc_xpbd_state *wc_xpbd_state_create(const wc_cloth *c)
+wc_xpbd_state *wci_xpbd_state_create(const wc_cloth *c)
 {
-    wc_xpbd_state *st = wc_alloc_array(1, sizeof *st);
+    wc_xpbd_state *st = wci_alloc_array(1, sizeof *st);
     if (!st) return NULL;
     if (!color_links(&c->topology.stretch, c->particle_count, &st->stretch)) {
-        wc_xpbd_state_destroy(st);
+        wci_xpbd_state_destroy(st);
         return NULL;
     }
     return st;
 }
 
-void wc_xpbd_state_destroy(wc_xpbd_state *st)
+void wci_xpbd_state_destroy(wc_xpbd_state *st)
 {
     if (!st) return;
     free_colors(&st->stretch);
-    wc_free(st);
+    wci_free(st);
 }
 
-int32_t wc_xpbd_color_count(const wc_xpbd_state *st) { return st->stretch.color_count; }
+int32_t wci_xpbd_color_count(const wc_xpbd_state *st) { return st->stretch.color_count; }
 
 /* One compliant projection of stretch link e (XPBD, Macklin, Mueller &
  * Chentanez 2016, eq. 18 with their Rayleigh damping, eq. 26), written with
@@ -180,19 +180,19 @@ static void sweep(wc_cloth *c, link_colors *lc, double h, int slack, int threads
         /* links of one colour share no particle: any thread order gives the
          * same bits; the serial remainder's do */
         int serial = lc->serial_last && k == lc->color_count - 1;
-        wc_parallel_for(count, serial ? 1 : wc_threads_for(count, threads), sweep_range, &pass);
+        wci_parallel_for(count, serial ? 1 : wc_threads_for(count, threads), sweep_range, &pass);
     }
 }
 
-int32_t wc_integrate_xpbd(wc_cloth *c, double dt, double pin_fraction, int threads)
+int32_t wci_integrate_xpbd(wc_cloth *c, double dt, double pin_fraction, int threads)
 {
     WC_ASSERT(c->xpbd != NULL);
     WC_ASSERT(dt > 0.0 && pin_fraction >= 0.0 && pin_fraction <= 1.0 && threads >= 1);
-    int32_t bad = wc_integrate_verlet(c, dt, pin_fraction, threads);
+    int32_t bad = wci_integrate_verlet(c, dt, pin_fraction, threads);
     if (bad >= 0) return bad;
     wc_xpbd_state *st = c->xpbd;
     memset(st->stretch.lambda, 0, (size_t)c->topology.stretch.count * sizeof(double));
     if (c->stretch_c) sweep(c, &st->stretch, dt, 1, threads);
     for (int it = 0; it < XPBD_ITERATIONS; ++it) sweep(c, &st->stretch, dt, 0, threads);
-    return wc_first_non_finite_xyz(c->nx, c->ny, c->nz, c->particle_count);
+    return wci_first_non_finite_xyz(c->nx, c->ny, c->nz, c->particle_count);
 }

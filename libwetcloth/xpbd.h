@@ -13,12 +13,12 @@
 typedef struct wc_xpbd_state wc_xpbd_state;
 
 /// Colours the cloth's stretch links. NULL when out of memory.
-wc_xpbd_state *wc_xpbd_state_create(const wc_cloth *cloth);
+wc_xpbd_state *wci_xpbd_state_create(const wc_cloth *cloth);
 
-void wc_xpbd_state_destroy(wc_xpbd_state *state);
+void wci_xpbd_state_destroy(wc_xpbd_state *state);
 
 /// Number of colours (the last one may be a serial remainder).
-int32_t wc_xpbd_color_count(const wc_xpbd_state *state);
+int32_t wci_xpbd_color_count(const wc_xpbd_state *state);
 
 /// Writes the positions after a step of dt into cloth->nx/ny/nz: the
 /// Verlet prediction from cloth->fx/fy/fz (which hold every force but the
@@ -28,6 +28,6 @@ int32_t wc_xpbd_color_count(const wc_xpbd_state *state);
 /// and never moved by a projection.
 /// Returns the index of the first particle whose new position is not
 /// finite, or -1 when all are. cloth->xpbd must exist (asserted).
-int32_t wc_integrate_xpbd(wc_cloth *cloth, double dt, double pin_fraction, int threads);
+int32_t wci_integrate_xpbd(wc_cloth *cloth, double dt, double pin_fraction, int threads);
 
 #endif

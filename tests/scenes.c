@@ -143,7 +143,7 @@ void scene_distances_to_mesh(const double *points, int32_t count, const double *
         double best = INFINITY;
         for (int32_t k = 0; k < triangle_count; ++k) {
             const int32_t *c = triangles + 3 * (size_t)k;
-            double d = wc_point_triangle_closest(points + 3 * (size_t)i, vertices + 3 * c[0],
+            double d = wci_point_triangle_closest(points + 3 * (size_t)i, vertices + 3 * c[0],
                                                  vertices + 3 * c[1], vertices + 3 * c[2], bary);
             if (d < best) best = d;
         }

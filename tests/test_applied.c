@@ -612,7 +612,7 @@ static void soft_pin_collides(int which, double wetness)
 /* ------------------------------------------------------------------------ */
 
 /* With air_drag 0 the air velocity has nothing to act through: bitwise the
- * same run as still air, and no pass runs (wc_applied_active). Cleared
+ * same run as still air, and no pass runs (wci_applied_active). Cleared
  * fields (NULL, 0) free their memory, and unpinned soft pins stop the
  * pass too. A field set to zero everywhere adds +0 to every force: the
  * same bits as none. */
@@ -627,7 +627,7 @@ static void no_effect(void)
         double *air = uniform_field(n, u), *zero = uniform_field(n, none);
         CHECK(wc_cloth_set_air_velocity(a, ia, air, n) == WC_OK, "air");
         wc_cloth *c = a->cloths[ia];
-        CHECK(!wc_applied_active(c), "%s: air velocity without drag runs the pass", NAME[which]);
+        CHECK(!wci_applied_active(c), "%s: air velocity without drag runs the pass", NAME[which]);
         CHECK(wc_cloth_set_external_forces(a, ia, zero, n) == WC_OK, "zero field");
         for (int s = 0; s < 50; ++s) wc_world_step(a, 1e-3), wc_world_step(b, 1e-3);
         CHECK(scene_hash_positions(a, ia) == scene_hash_positions(b, ib),
@@ -636,13 +636,13 @@ static void no_effect(void)
         CHECK(wc_cloth_set_air_velocity(a, ia, NULL, 0) == WC_OK &&
                   wc_cloth_set_external_forces(a, ia, NULL, 0) == WC_OK,
               "clearing: %s", wc_world_last_error(a));
-        CHECK(!c->air_velocity && !c->external_force && !wc_applied_active(c),
+        CHECK(!c->air_velocity && !c->external_force && !wci_applied_active(c),
               "%s: a cleared field stayed", NAME[which]);
         int32_t middle = 14;
         double stiff = 50.0;
         CHECK(wc_cloth_pin_soft(a, ia, &middle, &stiff, 1) == WC_OK, "pin_soft");
-        CHECK(wc_applied_active(c), "%s: a soft pin runs no pass", NAME[which]);
-        CHECK(wc_cloth_unpin_all(a, ia) == WC_OK && !wc_applied_active(c),
+        CHECK(wci_applied_active(c), "%s: a soft pin runs no pass", NAME[which]);
+        CHECK(wc_cloth_unpin_all(a, ia) == WC_OK && !wci_applied_active(c),
               "%s: the pass runs after unpin_all", NAME[which]);
         free(air), free(zero);
         wc_world_destroy(a), wc_world_destroy(b);

@@ -58,7 +58,7 @@ static void test_inverse_sinc_references(void)
     /* The five points the model asks for (r = 1-1e-15, 1-1e-8, 0.5, 1e-9, 0), as doubles r. Near r = 1 the problem
      * is ill-conditioned in r (d theta / d r ~ -3 / theta), but 1 - r is
      * exact for these doubles (Sterbenz), so the reference is theta for the
-     * exact value of the double r, and wc_inverse_sinc must hit it. */
+     * exact value of the double r, and wci_inverse_sinc must hit it. */
     static const struct {
         double r, theta;
     } pts[] = {
@@ -69,7 +69,7 @@ static void test_inverse_sinc_references(void)
         {0.0, 3.141592653589793},            /* pi */
     };
     for (size_t i = 0; i < sizeof pts / sizeof pts[0]; ++i) {
-        double t = wc_inverse_sinc(pts[i].r);
+        double t = wci_inverse_sinc(pts[i].r);
         double e = ulps(t, pts[i].theta);
         printf("inverse_sinc(r=%.17g) = %.17g, reference %.17g, error %.2f ulp\n", pts[i].r, t,
                pts[i].theta, e);
@@ -94,7 +94,7 @@ static void test_inverse_sinc_references(void)
         {0.973, 3.0589079551055107},
     };
     for (size_t i = 0; i < sizeof gaps / sizeof gaps[0]; ++i) {
-        double t = wc_inverse_sinc_gap(gaps[i].gap);
+        double t = wci_inverse_sinc_gap(gaps[i].gap);
         double e = ulps(t, gaps[i].theta);
         printf("inverse_sinc_gap(%.17g) = %.17g, error %.2f ulp\n", gaps[i].gap, t, e);
         CHECK(e <= THETA_ULPS, "inverse_sinc_gap(%.17g) = %.17g, expected %.17g (%.1f ulp)",
@@ -106,14 +106,14 @@ static void test_inverse_sinc_references(void)
     double tiny[] = {1e-30, 1e-100, 1e-300};
     for (int i = 0; i < 3; ++i) {
         double expect = (double)sqrtl(6.0L * (long double)tiny[i]);
-        double t = wc_inverse_sinc_gap(tiny[i]);
+        double t = wci_inverse_sinc_gap(tiny[i]);
         double e = ulps(t, expect);
         printf("inverse_sinc_gap(%g) = %.17g, sqrt(6 gap) = %.17g, error %.2f ulp\n", tiny[i], t,
                expect, e);
         CHECK(e <= THETA_ULPS, "inverse_sinc_gap(%g) = %.17g, expected %.17g", tiny[i], t, expect);
     }
-    CHECK(wc_inverse_sinc_gap(0.0) == 0.0, "theta(gap 0) = %g", wc_inverse_sinc_gap(0.0));
-    CHECK(wc_inverse_sinc(1.0) == 0.0, "theta(r = 1) = %g", wc_inverse_sinc(1.0));
+    CHECK(wci_inverse_sinc_gap(0.0) == 0.0, "theta(gap 0) = %g", wci_inverse_sinc_gap(0.0));
+    CHECK(wci_inverse_sinc(1.0) == 0.0, "theta(r = 1) = %g", wci_inverse_sinc(1.0));
 }
 
 /* ------------------------------------------------------------------------ */
@@ -152,7 +152,7 @@ static void test_inverse_sinc_sweep(void)
         int n = pass == 0 ? 200000 : 3000;
         for (int k = 0; k <= n; ++k) {
             double gap = pass == 0 ? (double)k / n : pow(10.0, -300.0 + 300.0 * k / n);
-            double t = wc_inverse_sinc_gap(gap);
+            double t = wci_inverse_sinc_gap(gap);
             ++count;
             if (!(t >= 0.0 && t <= PI)) {
                 if (bad++ < 5) CHECK(0, "theta(%.17g) = %.17g outside [0, pi]", gap, t);
@@ -226,10 +226,10 @@ static void test_force_limits_and_references(void)
         CHECK(wc_buckling_force(1.5 * l, l, R) == 0.0, "F(1.5 l) = %g",
               wc_buckling_force(1.5 * l, l, R));
         CHECK(wc_buckling_force(nextafter(l, INFINITY), l, R) == 0.0, "F(l^+) nonzero");
-        CHECK(wc_buckling_energy(l, l, R) == 0.0 && wc_buckling_energy(2.0 * l, l, R) == 0.0,
+        CHECK(wci_buckling_energy(l, l, R) == 0.0 && wci_buckling_energy(2.0 * l, l, R) == 0.0,
               "energy nonzero in tension");
         /* Energy at full fold: 2 R pi^2 / l. */
-        double e0 = wc_buckling_energy(0.0, l, R);
+        double e0 = wci_buckling_energy(0.0, l, R);
         CHECK(ulps(e0, 2.0 * R * PI * PI / l) <= 8.0, "U(0) = %.17g, expected %.17g", e0,
               2.0 * R * PI * PI / l);
 
@@ -256,13 +256,13 @@ static void test_force_limits_and_references(void)
             if (s == 0) printf("Phi(gap=%g) = %.17g, mpmath %.17g, rel error %.2e\n", ref[i].gap, f,
                                ref[i].phi, rel);
         }
-        /* wc_buckling_phi itself, at theta from the same table. */
-        CHECK(fabs(wc_buckling_phi(1.895494267033981) - 17.547251317025058) <= 1e-14 * 17.55,
-              "Phi(theta(0.5)) = %.17g", wc_buckling_phi(1.895494267033981));
-        CHECK(fabs(wc_buckling_phi(0.0) - 12.0) <= 1e-15 * 12.0, "Phi(0) = %.17g",
-              wc_buckling_phi(0.0));
-        CHECK(fabs(wc_buckling_phi(PI) - 4.0 * PI * PI) <= 1e-14 * 40.0, "Phi(pi) = %.17g",
-              wc_buckling_phi(PI));
+        /* wci_buckling_phi itself, at theta from the same table. */
+        CHECK(fabs(wci_buckling_phi(1.895494267033981) - 17.547251317025058) <= 1e-14 * 17.55,
+              "Phi(theta(0.5)) = %.17g", wci_buckling_phi(1.895494267033981));
+        CHECK(fabs(wci_buckling_phi(0.0) - 12.0) <= 1e-15 * 12.0, "Phi(0) = %.17g",
+              wci_buckling_phi(0.0));
+        CHECK(fabs(wci_buckling_phi(PI) - 4.0 * PI * PI) <= 1e-14 * 40.0, "Phi(pi) = %.17g",
+              wci_buckling_phi(PI));
     }
 }
 
@@ -349,7 +349,7 @@ static void test_force_is_energy_gradient(void)
     for (int k = 1; k < n; ++k) {
         double d = l * ((double)k / n);
         if (d - h < 0.0 || d + h > l) continue;
-        double fd = -(wc_buckling_energy(d + h, l, R) - wc_buckling_energy(d - h, l, R)) / (2.0 * h);
+        double fd = -(wci_buckling_energy(d + h, l, R) - wci_buckling_energy(d - h, l, R)) / (2.0 * h);
         double f = wc_buckling_force(d, l, R);
         double rel = fabs(fd - f) / (12.0 * unit);
         if (rel > worst) worst = rel;
@@ -381,7 +381,7 @@ static void test_force_matches_exact_path(void)
             gap = nextafter((double)j / 32.0, (k - n) % 2 ? 0.0 : 2.0);
         }
         if (gap > 1.0) gap = 1.0;
-        double exact = wc_buckling_phi(wc_inverse_sinc_gap(gap));
+        double exact = wci_buckling_phi(wci_inverse_sinc_gap(gap));
         double f = wc_buckling_force(1.0 - gap, 1.0, 1.0);
         double rel = fabs(f - exact) / exact;
         if (rel > worst) worst = rel, worst_gap = gap;
@@ -395,7 +395,7 @@ static void test_force_matches_exact_path(void)
 /* The force as the simulation applies it (WC_BUCKLING_ONSET_RAMP): zero at
  * and beyond the rest length; linear in the compression up to a gap of
  * 1e-3, where it meets the exact force continuously; exactly the Choi-Ko
- * force beyond; minus the gradient of wc_buckling_energy_ramped; its slope
+ * force beyond; minus the gradient of wci_buckling_energy_ramped; its slope
  * within WC_BUCKLING_STIFFNESS_BOUND_RAMPED R / l^3. */
 static void test_ramped_force(void)
 {
@@ -416,7 +416,7 @@ static void test_ramped_force(void)
         /* (the difference may not straddle the ramp's corner, where the
          * force's slope changes: there it is off by ~h times that change) */
         if (d - h > 0.0 && d + h < l && fabs((l - d) / l - ramp) > 2e-7) {
-            double grad = (wc_buckling_energy_ramped(d - h, l, R) - wc_buckling_energy_ramped(d + h, l, R)) / (2 * h);
+            double grad = (wci_buckling_energy_ramped(d - h, l, R) - wci_buckling_energy_ramped(d + h, l, R)) / (2 * h);
             worst_gradient = fmax(worst_gradient, fabs(grad - f) / f);
             double slope = fabs(wc_buckling_force_ramped(d - h, l, R) - wc_buckling_force_ramped(d + h, l, R)) / (2 * h);
             worst_slope = fmax(worst_slope, slope * l * l * l / R);

@@ -17,7 +17,7 @@
 #include "test_util.h"
 #include "wetcloth.h"
 
-/* ---- wc_triangles_intersect ---- */
+/* ---- wci_triangles_intersect ---- */
 
 /* Checks a pair both ways round, with the vertices of each rotated, so the
  * answer cannot depend on the order of the arguments. */
@@ -27,7 +27,7 @@ static void expect_pair(const double p[3][3], const double q[3][3], int expect, 
         for (int rp = 0; rp < 3; ++rp)
             for (int rq = 0; rq < 3; ++rq) {
                 const double(*a)[3] = swap ? q : p, (*b)[3] = swap ? p : q;
-                int got = wc_triangles_intersect(a[rp], a[(rp + 1) % 3], a[(rp + 2) % 3], b[rq],
+                int got = wci_triangles_intersect(a[rp], a[(rp + 1) % 3], a[(rp + 2) % 3], b[rq],
                                                  b[(rq + 1) % 3], b[(rq + 2) % 3]);
                 CHECK(got == expect, "%s (swap %d, rotations %d %d): %d, expected %d", what, swap, rp, rq,
                       got, expect);
@@ -202,16 +202,16 @@ static void test_random_pairs(void)
             q[j][1] = cy + uniform(-0.05, 0.05);
             q[j][2] = j == 0 ? uniform(-1, -0.01) : uniform(0.01, 1);
         }
-        int crossing = wc_triangles_intersect(p[0], p[1], p[2], q[0], q[1], q[2]);
+        int crossing = wci_triangles_intersect(p[0], p[1], p[2], q[0], q[1], q[2]);
         /* lifted above the plane entirely */
         double lift = 1.02 - q[0][2];
         double r[3][3];
         for (int j = 0; j < 3; ++j) memcpy(r[j], q[j], sizeof r[j]), r[j][2] += lift;
-        int apart = wc_triangles_intersect(p[0], p[1], p[2], r[0], r[1], r[2]);
+        int apart = wci_triangles_intersect(p[0], p[1], p[2], r[0], r[1], r[2]);
         if (!crossing || apart) {
             if (wrong++ < 3) CHECK(0, "random pair %d: crossing %d, lifted %d", i, crossing, apart);
         }
-        int swapped = wc_triangles_intersect(q[2], q[0], q[1], p[1], p[2], p[0]);
+        int swapped = wci_triangles_intersect(q[2], q[0], q[1], p[1], p[2], p[0]);
         if (swapped != crossing && wrong++ < 3) CHECK(0, "random pair %d: swapping changed the answer", i);
     }
     CHECK(wrong == 0, "%d random pairs wrong", wrong);
@@ -423,7 +423,7 @@ static void test_against_all_pairs(int with_ground)
     wc_convex_shape box;
     wc_pose pose;
     wc_message msg;
-    CHECK(wc_convex_shape_init(&box, &pose, &sd, &msg) == WC_OK, "box shape: %s", msg.text);
+    CHECK(wci_convex_shape_create(&box, &pose, &sd, &msg) == WC_OK, "box shape: %s", msg.text);
 
     int32_t nt[2], np[2], *tri[2];
     double *pos[2];
@@ -447,12 +447,12 @@ static void test_against_all_pairs(int with_ground)
                     for (int x = 0; x < 3 && l == k; ++x)
                         for (int y = 0; y < 3; ++y) share |= ti[x] == tj[y];
                     if (share) continue;
-                    cc += wc_triangles_intersect(p0, p1, p2, pos[l] + 3 * tj[0], pos[l] + 3 * tj[1],
+                    cc += wci_triangles_intersect(p0, p1, p2, pos[l] + 3 * tj[0], pos[l] + 3 * tj[1],
                                                  pos[l] + 3 * tj[2]);
                 }
             for (int u = 0; u < 3; ++u)
-                cl += wc_triangles_intersect(p0, p1, p2, v + 3 * t[3 * u], v + 3 * t[3 * u + 1], v + 3 * t[3 * u + 2]);
-            cl += wc_convex_triangle_intersects(&box, &pose, p0, p1, p2);
+                cl += wci_triangles_intersect(p0, p1, p2, v + 3 * t[3 * u], v + 3 * t[3 * u + 1], v + 3 * t[3 * u + 2]);
+            cl += wci_convex_triangle_intersects(&box, &pose, p0, p1, p2);
         }
     wc_intersection_counts n = count(w, "crumpled scene");
     CHECK(n.cloth_cloth == cc && n.cloth_collider == cl,
@@ -462,7 +462,7 @@ static void test_against_all_pairs(int with_ground)
     printf("crumpled scene%s: %d cloth-cloth and %d cloth-collider pairs, as testing all pairs finds\n",
            with_ground ? " with a ground" : "", cc, cl);
     for (int k = 0; k < 2; ++k) free(tri[k]), free(pos[k]);
-    wc_convex_shape_free(&box);
+    wci_convex_shape_destroy(&box);
     wc_world_destroy(w);
 }
 

@@ -477,7 +477,7 @@ static uint64_t thesis_hash(int use_filter, wc_integrator integrator, int steps_
     for (int f = 0; f < 12; ++f) {
         advance_or_fail(w, 1.0 / 24, steps_per_frame);
         *steps += wc_world_last_substeps(w);
-        if (f == 0) wc_collider_contacts_use_filter(w->cloths[cl]->collider_contacts, use_filter);
+        if (f == 0) wci_collider_contacts_use_filter(w->cloths[cl]->collider_contacts, use_filter);
         contacts += wc_world_get_stats(w).collider_contacts;
     }
     CHECK(contacts > 0, "the cloth never reached the sphere");

@@ -36,8 +36,8 @@ static wc_convex_shape make(const wc_convex_collider_def *d)
     wc_convex_shape s;
     wc_pose p;
     wc_message m = {{0}};
-    wc_status st = wc_convex_shape_init(&s, &p, d, &m);
-    CHECK(st == WC_OK, "wc_convex_shape_init: %s", m.text);
+    wc_status st = wci_convex_shape_create(&s, &p, d, &m);
+    CHECK(st == WC_OK, "wci_convex_shape_create: %s", m.text);
     return s;
 }
 
@@ -122,7 +122,7 @@ static void check_ball(const wc_convex_shape *s, const char *what, double x, dou
                        double r, double expect_depth, const double *expect_normal)
 {
     double c[3] = {x, y, z}, depth = -1, dir[3] = {0, 0, 0};
-    int hit = wc_convex_penetration(s, c, r, &depth, dir);
+    int hit = wci_convex_penetration(s, c, r, &depth, dir);
     if (expect_depth <= 0) {
         CHECK(!hit, "%s at (%g, %g, %g) r %g: contact reported (depth %g), none expected", what, x,
               y, z, r, depth);
@@ -158,7 +158,7 @@ static void test_sphere_points(void)
     check_ball(&s, "sphere far", 10, 0, 0, 0.01, 0, NULL);
     /* at the very centre any direction is right; the depth is r + radius */
     check_ball(&s, "sphere centre", 0, 0, 0, 0.05, 0.55, NULL);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 static void test_capsule_points(void)
@@ -174,7 +174,7 @@ static void test_capsule_points(void)
     check_ball(&s, "capsule inside", 0.15, 0, -0.3, 0.05, 0.1, x);
     check_ball(&s, "capsule clear", 0.3, 0, 0, 0.05, 0, NULL);
     check_ball(&s, "capsule beyond the cap", 0, 0, 0.7, 0.05, 0, NULL);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 /* Box and cube hull share the same cases (a cube of half size 0.5). */
@@ -214,11 +214,11 @@ static void test_box_points(void)
     wc_convex_shape s = make(&d);
     CHECK(fabs(s.bound_radius - sqrt(0.75)) < 1e-15, "box bound radius %g", s.bound_radius);
     check_cube(&s, "box");
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     d = hull_def(cube_points, 8);
     s = make(&d);
     check_cube(&s, "cube hull");
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 
     /* A long thin plate: plain MPR measures along the ray from the centre,
      * which here leaves through the far end (0.9 m off); the exact answer is
@@ -227,7 +227,7 @@ static void test_box_points(void)
     s = make(&d);
     check_ball(&s, "plate under its end", 0.79, 0.17, -0.06, 0.03, 0.02, (double[3]){0, 0, -1});
     check_ball(&s, "plate inside near its end", 0.9, 0.0, 0.03, 0.01, 0.03, (double[3]){0, 0, 1});
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 static void test_octahedron_points(void)
@@ -242,7 +242,7 @@ static void test_octahedron_points(void)
     /* beyond the apex (0, 0, 1) along z: the apex is nearest */
     check_ball(&s, "octahedron apex", 0, 0, 1.03, 0.05, 0.02, (double[3]){0, 0, 1});
     check_ball(&s, "octahedron clear", 0, 0, 1.06, 0.05, 0, NULL);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 /* Random positions near each shape against the closed forms; the pushed-out
@@ -257,7 +257,7 @@ static void sweep_random(const char *what, const wc_convex_shape *s, double (*sd
         double c[3] = {uniform(-1.3, 1.3), uniform(-1.3, 1.3), uniform(-1.3, 1.3)};
         double r = uniform(0.005, 0.12);
         double expect = r - sd(s, c), depth = 0, dir[3];
-        int hit = wc_convex_penetration(s, c, r, &depth, dir);
+        int hit = wci_convex_penetration(s, c, r, &depth, dir);
         if (fabs(expect) < 1e-9) continue; /* touching: either answer is right */
         if ((expect > 0) != (hit != 0)) {
             if (wrong++ < 3)
@@ -299,27 +299,27 @@ static void test_random_positions(void)
     wc_convex_collider_def d = sphere_def(0.7);
     wc_convex_shape s = make(&d);
     sweep_random("sphere", &s, sd_of_sphere, 40000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     d = capsule_def(0.3, 0.6);
     s = make(&d);
     sweep_random("capsule", &s, sd_of_capsule, 40000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     d = box_def(1.0, 0.5, 0.05);
     s = make(&d);
     sweep_random("plate box", &s, sd_of_box, 40000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     d = box_def(0.5, 0.5, 0.5);
     s = make(&d);
     sweep_random("cube box", &s, sd_of_box, 40000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     d = hull_def(cube_points, 8);
     s = make(&d);
     sweep_random("cube hull", &s, sd_of_cube_hull, 40000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     d = hull_def(octa_points, 6);
     s = make(&d);
     sweep_random("octahedron hull", &s, sd_of_octahedron, 40000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 /* ---- a random hull against brute-force facets ---- */
@@ -430,7 +430,7 @@ static void test_random_hull(void)
     wc_convex_collider_def d = hull_def(hull_pts, n);
     wc_convex_shape s = make(&d);
     sweep_random("random hull", &s, sd_random_hull, 40000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 /* ---- moving particles ---- */
@@ -439,7 +439,7 @@ static void check_resolve(const wc_convex_shape *s, const char *what, const doub
                           double r, const double expect[3], const double expect_normal[3], double tol)
 {
     double out[3] = {7, 7, 7}, n[3] = {7, 7, 7};
-    int hit = wc_convex_resolve(s, a, b, r, out, n);
+    int hit = wci_convex_resolve(s, a, b, r, out, n);
     if (!expect) {
         CHECK(!hit, "%s: contact reported at (%g, %g, %g)", what, out[0], out[1], out[2]);
         CHECK(out[0] == 7 && n[0] == 7, "%s: outputs written without contact", what);
@@ -455,9 +455,9 @@ static void check_resolve(const wc_convex_shape *s, const char *what, const doub
           expect_normal[0], expect_normal[1], expect_normal[2]);
     /* the result keeps exactly r from the surface */
     double depth, dir[3];
-    CHECK(!wc_convex_penetration(s, out, r * (1 - 1e-9), &depth, dir), "%s: result still inside",
+    CHECK(!wci_convex_penetration(s, out, r * (1 - 1e-9), &depth, dir), "%s: result still inside",
           what);
-    CHECK(wc_convex_penetration(s, out, r * (1 + 1e-6), &depth, dir), "%s: result not on the surface",
+    CHECK(wci_convex_penetration(s, out, r * (1 + 1e-6), &depth, dir), "%s: result not on the surface",
           what);
 }
 
@@ -489,7 +489,7 @@ static void test_resolve(void)
         double a3[3] = {5, 5, 5}, b3[3] = {5, 5, 6};
         check_resolve(&s, "sphere, far away", a3, b3, r, NULL, NULL, 0);
     }
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 
     d = box_def(0.3, 0.3, 0.3);
     s = make(&d);
@@ -509,7 +509,7 @@ static void test_resolve(void)
         double a4[3] = {-0.5, 0.0, 0.32}, b4[3] = {0.5, 0.0, 0.32};
         check_resolve(&s, "box, skimming over", a4, b4, r, NULL, NULL, 0);
     }
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 /* Random motions around a box and a sphere: every contact ends exactly r
@@ -537,7 +537,7 @@ static void random_resolve(const char *what, const wc_convex_shape *s,
             if (d < closest) closest = d;
         }
         double out[3], n[3];
-        int hit = wc_convex_resolve(s, a, b, r, out, n);
+        int hit = wci_convex_resolve(s, a, b, r, out, n);
         int must = closest < 0.5 * r || sd(s, b) < r * (1 - 1e-6);
         int must_not = closest > r * (1 + 1e-6);
         if ((must && !hit) || (must_not && hit)) {
@@ -566,15 +566,15 @@ static void test_random_resolve(void)
     wc_convex_collider_def d = sphere_def(0.5);
     wc_convex_shape s = make(&d);
     random_resolve("sphere", &s, sd_of_sphere, 3000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     d = box_def(0.4, 0.3, 0.2);
     s = make(&d);
     random_resolve("box", &s, sd_of_box, 3000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     d = hull_def(octa_points, 6);
     s = make(&d);
     random_resolve("octahedron", &s, sd_of_octahedron, 3000);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 /* ---- triangles ---- */
@@ -586,15 +586,15 @@ static void test_triangles(void)
     wc_pose pose = {{1, 2, 3}, {1, 0, 0, 0}};
     /* a big triangle in a plane through the centre: the case MPR gets wrong */
     double a[3] = {-2, 0, 3}, b[3] = {4, -3, 3}, c[3] = {4, 6, 3};
-    CHECK(wc_convex_triangle_intersects(&s, &pose, a, b, c), "triangle through the sphere's centre");
+    CHECK(wci_convex_triangle_intersects(&s, &pose, a, b, c), "triangle through the sphere's centre");
     double a2[3] = {-2, 0, 3.49}, b2[3] = {4, -3, 3.49}, c2[3] = {4, 6, 3.49};
-    CHECK(wc_convex_triangle_intersects(&s, &pose, a2, b2, c2), "triangle cutting the sphere's cap");
+    CHECK(wci_convex_triangle_intersects(&s, &pose, a2, b2, c2), "triangle cutting the sphere's cap");
     double a3[3] = {-2, 0, 3.51}, b3[3] = {4, -3, 3.51}, c3[3] = {4, 6, 3.51};
-    CHECK(!wc_convex_triangle_intersects(&s, &pose, a3, b3, c3), "triangle above the sphere");
+    CHECK(!wci_convex_triangle_intersects(&s, &pose, a3, b3, c3), "triangle above the sphere");
     /* small triangle wholly inside */
     double a4[3] = {1, 2, 3}, b4[3] = {1.1, 2, 3}, c4[3] = {1, 2.1, 3.05};
-    CHECK(wc_convex_triangle_intersects(&s, &pose, a4, b4, c4), "triangle inside the sphere");
-    wc_convex_shape_free(&s);
+    CHECK(wci_convex_triangle_intersects(&s, &pose, a4, b4, c4), "triangle inside the sphere");
+    wci_convex_shape_destroy(&s);
 
     /* a box turned 45 degrees about z: its corner reaches x = 0.3 sqrt 2 */
     d = box_def(0.3, 0.3, 0.3);
@@ -603,16 +603,16 @@ static void test_triangles(void)
     wc_pose turned = {{0, 0, 0}, {w, 0, 0, h}};
     double x = 0.3 * sqrt(2.0);
     double t1[3] = {x - 0.001, -1, -1}, t2[3] = {x - 0.001, 1, -1}, t3[3] = {x - 0.001, 0, 1};
-    CHECK(wc_convex_triangle_intersects(&s, &turned, t1, t2, t3), "triangle at the turned box's edge");
+    CHECK(wci_convex_triangle_intersects(&s, &turned, t1, t2, t3), "triangle at the turned box's edge");
     t1[0] = t2[0] = t3[0] = x + 0.001;
-    CHECK(!wc_convex_triangle_intersects(&s, &turned, t1, t2, t3), "triangle beyond the turned box");
+    CHECK(!wci_convex_triangle_intersects(&s, &turned, t1, t2, t3), "triangle beyond the turned box");
     /* a vertex at infinity or NaN (an exploded cloth): not counted, and
      * libccd is not asked */
     double bad[3] = {0.0, 0.0, INFINITY}, o1[3] = {0, 0, 0}, o2[3] = {0.1, 0, 0};
-    CHECK(!wc_convex_triangle_intersects(&s, &turned, o1, o2, bad), "triangle with an infinite vertex");
+    CHECK(!wci_convex_triangle_intersects(&s, &turned, o1, o2, bad), "triangle with an infinite vertex");
     bad[2] = NAN;
-    CHECK(!wc_convex_triangle_intersects(&s, &turned, o1, o2, bad), "triangle with a NaN vertex");
-    wc_convex_shape_free(&s);
+    CHECK(!wci_convex_triangle_intersects(&s, &turned, o1, o2, bad), "triangle with a NaN vertex");
+    wci_convex_shape_destroy(&s);
 }
 
 /* ---- poses ---- */
@@ -624,11 +624,11 @@ static void test_poses(void)
     for (int k = 0; k < 4; ++k) q[k] /= sqrt(l);
     wc_pose p = {{0.5, -1.0, 2.0}, {q[0], q[1], q[2], q[3]}};
     double v[3] = {0.3, 0.4, -1.2}, w[3], back[3], rv[3];
-    wc_pose_to_world(&p, v, w);
-    wc_pose_to_local(&p, w, back);
+    wci_pose_to_world(&p, v, w);
+    wci_pose_to_local(&p, w, back);
     double e = fabs(back[0] - v[0]) + fabs(back[1] - v[1]) + fabs(back[2] - v[2]);
     CHECK(e < 1e-15, "to_world then to_local: off by %g", e);
-    wc_pose_rotate(&p, v, rv);
+    wci_pose_rotate(&p, v, rv);
     CHECK(fabs(len(rv) - len(v)) < 1e-15, "rotation changed a length: %g vs %g", len(rv), len(v));
     for (int k = 0; k < 3; ++k)
         CHECK(fabs(w[k] - (rv[k] + p.position[k])) < 1e-15, "to_world is not rotate + translate");
@@ -644,17 +644,17 @@ static void test_poses(void)
     /* 90 degrees about z takes x to y */
     wc_pose qz = {{0, 0, 0}, {sqrt(0.5), 0, 0, sqrt(0.5)}};
     double ex[3] = {1, 0, 0}, ey[3];
-    wc_pose_rotate(&qz, ex, ey);
+    wci_pose_rotate(&qz, ex, ey);
     CHECK(fabs(ey[0]) < 1e-15 && fabs(ey[1] - 1) < 1e-15 && fabs(ey[2]) < 1e-15,
           "90 degrees about z: (%g, %g, %g)", ey[0], ey[1], ey[2]);
 
     /* lerp: exact ends, midpoint, shorter arc */
     wc_pose a = {{0, 0, 0}, {1, 0, 0, 0}}, b = {{2, 4, -6}, {sqrt(0.5), 0, 0, sqrt(0.5)}}, o;
-    wc_pose_lerp(&a, &b, 0.0, &o);
+    wci_pose_lerp(&a, &b, 0.0, &o);
     CHECK(memcmp(&o, &a, sizeof o) == 0, "lerp at 0 is not a");
-    wc_pose_lerp(&a, &b, 1.0, &o);
+    wci_pose_lerp(&a, &b, 1.0, &o);
     CHECK(memcmp(&o, &b, sizeof o) == 0, "lerp at 1 is not b");
-    wc_pose_lerp(&a, &b, 0.5, &o);
+    wci_pose_lerp(&a, &b, 0.5, &o);
     CHECK(fabs(o.position[0] - 1) < 1e-15 && fabs(o.position[1] - 2) < 1e-15 && fabs(o.position[2] + 3) < 1e-15,
           "lerp midpoint position (%g, %g, %g)", o.position[0], o.position[1], o.position[2]);
     /* nlerp halfway between 0 and 90 degrees about z is 45 degrees */
@@ -665,10 +665,10 @@ static void test_poses(void)
     wc_pose nb = b;
     for (int k = 0; k < 4; ++k) nb.rotation[k] = -b.rotation[k];
     wc_pose o2;
-    wc_pose_lerp(&a, &nb, 0.5, &o2);
+    wci_pose_lerp(&a, &nb, 0.5, &o2);
     double r1[3], r2[3];
-    wc_pose_rotate(&o, ex, r1);
-    wc_pose_rotate(&o2, ex, r2);
+    wci_pose_rotate(&o, ex, r1);
+    wci_pose_rotate(&o2, ex, r2);
     CHECK(fabs(r1[0] - r2[0]) < 1e-15 && fabs(r1[1] - r2[1]) < 1e-15,
           "lerp toward -q took the long way: (%g, %g) vs (%g, %g)", r2[0], r2[1], r1[0], r1[1]);
     double ql = 0;
@@ -683,11 +683,11 @@ static void expect_invalid(const wc_convex_collider_def *d, const char *needle, 
     wc_convex_shape s;
     wc_pose p;
     wc_message m = {{0}};
-    wc_status st = wc_convex_shape_init(&s, &p, d, &m);
+    wc_status st = wci_convex_shape_create(&s, &p, d, &m);
     CHECK(st == WC_ERROR_INVALID_ARGUMENT, "%s: status %s", what, wc_status_name(st));
     CHECK(strstr(m.text, needle) != NULL, "%s: message \"%s\" does not name \"%s\"", what, m.text, needle);
     CHECK(s.points == NULL, "%s: points allocated on failure", what);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 static void test_validation(void)
@@ -759,26 +759,26 @@ static void test_validation(void)
     wc_convex_shape s;
     wc_pose p;
     wc_message m = {{0}};
-    CHECK(wc_convex_shape_init(&s, &p, &d, &m) == WC_OK, "sphere with junk box fields: %s", m.text);
-    wc_convex_shape_free(&s);
+    CHECK(wci_convex_shape_create(&s, &p, &d, &m) == WC_OK, "sphere with junk box fields: %s", m.text);
+    wci_convex_shape_destroy(&s);
 
     /* a good hull: points copied, rotation normalised, bound radius */
     d = hull_def(octa_points, 6);
     d.rotation[0] = 2.0;
     d.position[2] = 3.0;
-    CHECK(wc_convex_shape_init(&s, &p, &d, &m) == WC_OK, "octahedron: %s", m.text);
+    CHECK(wci_convex_shape_create(&s, &p, &d, &m) == WC_OK, "octahedron: %s", m.text);
     CHECK(s.points != octa_points && s.points && memcmp(s.points, octa_points, sizeof octa_points) == 0,
           "hull points not copied");
     CHECK(p.rotation[0] == 1.0 && p.position[2] == 3.0, "pose not normalised/copied");
     CHECK(fabs(s.bound_radius - 1.0) < 1e-15, "octahedron bound radius %g", s.bound_radius);
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
     CHECK(s.points == NULL, "free left the points");
 }
 
 /* An exploded cloth's particle moving from ~1e72 m to ~2e81 m in one step
  * on a line that passes within reach of a capsule (the coordinates of a
  * fuzz input that timed out): libccd's MPR, asked whether that path meets
- * the capsule, turned forever on rounding. Checked: wc_convex_resolve
+ * the capsule, turned forever on rounding. Checked: wci_convex_resolve
  * returns (without the fix this test hangs until ctest's timeout), and
  * what it gives is finite. */
 static void test_exploded_path(void)
@@ -790,10 +790,10 @@ static void test_exploded_path(void)
     const double a[3] = {1.1527361862470264e+72, -8.5614729931985079e+71, -8.1971527105887753e+70};
     const double b[3] = {-2.3567254664727314e+81, 1.7503607221076334e+81, 1.6758768203942447e+80};
     double out[3] = {0, 0, 0}, n[3] = {0, 0, 0};
-    if (wc_convex_resolve(&s, a, b, 0.005, out, n))
+    if (wci_convex_resolve(&s, a, b, 0.005, out, n))
         for (int k = 0; k < 3; ++k)
             CHECK(isfinite(out[k]) && isfinite(n[k]), "exploded path: non-finite result");
-    wc_convex_shape_free(&s);
+    wci_convex_shape_destroy(&s);
 }
 
 /* A particle whose end position, taken into a hull's frame, overflowed to
@@ -812,17 +812,17 @@ static void test_overflowing_path(void)
     double r = 0x1.47ae147ae147bp-8, out[3] = {0, 0, 0}, n[3] = {0, 0, 0};
     const double a[3] = {-0x1p-2, -0x1p-2, 0.0};
     const double b[3] = {-0x1.1ccf385ebc89fp+1023, -0x1p+971, INFINITY};
-    CHECK(!wc_convex_resolve(&s, a, b, r, out, n), "infinite end reported as a contact");
+    CHECK(!wci_convex_resolve(&s, a, b, r, out, n), "infinite end reported as a contact");
     /* from ~1.5e308 m away into the hull, 0.05 m under its top face z = 0 */
     const double far[3] = {-1.5e308, 0.0, -1.5e308}, inside[3] = {-0.1, -0.15, -0.05};
-    CHECK(wc_convex_resolve(&s, far, inside, r, out, n), "end inside the hull not pushed out");
+    CHECK(wci_convex_resolve(&s, far, inside, r, out, n), "end inside the hull not pushed out");
     double depth = 0.0, dir[3];
     CHECK(isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]), "pushed-out end not finite");
-    CHECK(!wc_convex_penetration(&s, out, r * (1.0 - 1e-9), &depth, dir),
+    CHECK(!wci_convex_penetration(&s, out, r * (1.0 - 1e-9), &depth, dir),
           "pushed-out end still inside by %g", depth);
     const double gone[3] = {1.5e308, 0.0, 1.5e308};
-    CHECK(!wc_convex_resolve(&s, far, gone, r, out, n), "far path with a far end reported as a contact");
-    wc_convex_shape_free(&s);
+    CHECK(!wci_convex_resolve(&s, far, gone, r, out, n), "far path with a far end reported as a contact");
+    wci_convex_shape_destroy(&s);
 }
 
 /* A coordinate anywhere in the doubles: near the shape, far, enormous,
@@ -836,7 +836,7 @@ static double extreme_coordinate(void)
     return u < 0.95 ? sign * INFINITY : NAN;
 }
 
-/* wc_convex_resolve and wc_convex_penetration on paths and points from
+/* wci_convex_resolve and wci_convex_penetration on paths and points from
  * extreme_coordinate, against every kind of shape: libccd is never handed
  * something it cannot take (the sanitizer build would see a bad read, as it
  * did for the overflowing path above), and whatever is returned is finite:
@@ -852,14 +852,14 @@ static void test_extreme_inputs(void)
             double a[3], b[3], out[3], n[3], depth, dir[3];
             for (int k = 0; k < 3; ++k) a[k] = extreme_coordinate(), b[k] = extreme_coordinate();
             if (trial % 3 == 0) memcpy(a, b, sizeof a);
-            if (wc_convex_resolve(&s, a, b, 0.005, out, n)) {
+            if (wci_convex_resolve(&s, a, b, 0.005, out, n)) {
                 ++hits;
                 bad += !(isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]) && fabs(len(n) - 1.0) < 1e-9);
             }
-            if (wc_convex_penetration(&s, b, 0.005, &depth, dir))
+            if (wci_convex_penetration(&s, b, 0.005, &depth, dir))
                 bad += !(isfinite(depth) && depth > 0.0 && fabs(len(dir) - 1.0) < 1e-9);
         }
-        wc_convex_shape_free(&s);
+        wci_convex_shape_destroy(&s);
     }
     printf("extreme inputs: 12000 paths, %d contacts, %d with a non-finite or non-unit answer\n", hits,
            bad);

@@ -34,8 +34,8 @@ static void scene(int32_t n, double item_size, double cell_size, double query_si
     int32_t *found = malloc(sizeof(int32_t) * (size_t)n), *expect = malloc(sizeof(int32_t) * (size_t)n);
     for (int32_t i = 0; i < n; ++i) random_box(boxes + 6 * i, 1.0, item_size * (i % 50 == 0 ? 20.0 : 1.0));
     wc_grid g;
-    wc_grid_init(&g);
-    CHECK(wc_grid_build(&g, boxes, n, cell_size) == WC_OK, "build failed");
+    memset(&g, 0, sizeof g);
+    CHECK(wci_grid_update(&g, boxes, n, cell_size) == WC_OK, "build failed");
     int mismatches = 0;
     long total = 0;
     for (int q = 0; q < queries; ++q) {
@@ -46,7 +46,7 @@ static void scene(int32_t n, double item_size, double cell_size, double query_si
         int32_t m = 0;
         for (int32_t i = 0; i < n; ++i)
             if (wc_boxes_overlap(box, boxes + 6 * i)) expect[m++] = i;
-        int32_t got = wc_grid_query(&g, box, found, n);
+        int32_t got = wci_grid_query(&g, box, found, n);
         total += got;
         int same = got == m;
         for (int32_t k = 0; same && k < m; ++k) same = found[k] == expect[k];
@@ -59,8 +59,8 @@ static void scene(int32_t n, double item_size, double cell_size, double query_si
     CHECK(mismatches == 0, "%d queries differ from brute force", mismatches);
     /* a capacity smaller than the result still reports the full count */
     double all[6] = {-2, -2, -2, 2, 2, 2};
-    CHECK(wc_grid_query(&g, all, found, 3) == n, "count with a small buffer");
-    wc_grid_free(&g);
+    CHECK(wci_grid_query(&g, all, found, 3) == n, "count with a small buffer");
+    wci_grid_destroy(&g);
     free(boxes);
     free(found);
     free(expect);
@@ -76,15 +76,15 @@ static void huge_boxes(void)
                         -1e12, -1e12, -1e12, 1e12, 1e12, 1e12,
                         5.0, 5.0, 5.0, 5.1, 5.1, 5.1};
     wc_grid g;
-    wc_grid_init(&g);
-    CHECK(wc_grid_build(&g, boxes, 3, 0.05) == WC_OK, "build failed");
+    memset(&g, 0, sizeof g);
+    CHECK(wci_grid_update(&g, boxes, 3, 0.05) == WC_OK, "build failed");
     double query[6] = {-1e300, -1e300, -1e300, 1e300, 1e300, 1e300}, small[6] = {0.05, 0.05, 0.05, 0.06, 0.06, 0.06};
     int32_t found[3] = {-1, -1, -1};
-    int32_t n = wc_grid_query(&g, query, found, 3);
+    int32_t n = wci_grid_query(&g, query, found, 3);
     CHECK(n == 3 && found[0] == 0 && found[1] == 1 && found[2] == 2, "huge query: %d items", (int)n);
-    n = wc_grid_query(&g, small, found, 3);
+    n = wci_grid_query(&g, small, found, 3);
     CHECK(n == 2 && found[0] == 0 && found[1] == 1, "small query: %d items", (int)n);
-    wc_grid_free(&g);
+    wci_grid_destroy(&g);
 }
 
 /* The tree over n boxes: queries against brute force, then the boxes
@@ -95,8 +95,8 @@ static void tree(int32_t n, double item_size, double query_size, int queries)
     int32_t *found = malloc(sizeof(int32_t) * (size_t)n), *expect = malloc(sizeof(int32_t) * (size_t)n);
     for (int32_t i = 0; i < n; ++i) random_box(boxes + 6 * i, 1.0, item_size);
     wc_bvh b;
-    wc_bvh_init(&b);
-    CHECK(wc_bvh_build(&b, boxes, n) == WC_OK, "tree build failed");
+    memset(&b, 0, sizeof b);
+    CHECK(wci_bvh_create(&b, boxes, n) == WC_OK, "tree build failed");
     int mismatches = 0;
     long total = 0;
     for (int round = 0; round < 2; ++round) {
@@ -107,12 +107,12 @@ static void tree(int32_t n, double item_size, double query_size, int queries)
                 double shift[3] = {uniform(-0.5, 0.5), uniform(-0.5, 0.5), uniform(-0.5, 0.5)};
                 for (int k = 0; k < 3; ++k) boxes[6 * i + k] += shift[k], boxes[6 * i + k + 3] += shift[k];
             }
-            wc_bvh_refit(&b);
+            wci_bvh_refit(&b);
         }
         for (int q = 0; q < queries; ++q) {
             double box[6];
             random_box(box, 1.2, query_size);
-            int32_t got = wc_bvh_query(&b, box, found, n), want = 0;
+            int32_t got = wci_bvh_query(&b, box, found, n), want = 0;
             for (int32_t i = 0; i < n; ++i)
                 if (wc_boxes_overlap(box, boxes + 6 * i)) expect[want++] = i;
             total += want;
@@ -129,11 +129,11 @@ static void tree(int32_t n, double item_size, double query_size, int queries)
     }
     /* a full buffer: the count without overrun */
     double all[6] = {-10, -10, -10, 10, 10, 10};
-    CHECK(wc_bvh_query(&b, all, found, 1) == n, "a query with a small buffer must still count all");
+    CHECK(wci_bvh_query(&b, all, found, 1) == n, "a query with a small buffer must still count all");
     printf("tree: %d items, %d queries twice (after a refit), %ld hits, %d mismatches\n", (int)n,
            queries, total, mismatches);
     CHECK(mismatches == 0, "tree queries differ from brute force");
-    wc_bvh_free(&b);
+    wci_bvh_destroy(&b);
     free(boxes), free(found), free(expect);
 }
 

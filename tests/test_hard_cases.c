@@ -41,7 +41,7 @@ static int energy_without_stretch; /* see world_energy */
 
 static const char *INTEGRATOR[3] = {"verlet", "xpbd", "implicit"};
 
-static double wall_seconds(void) { return wc_clock_seconds(); }
+static double wall_seconds(void) { return wci_clock_seconds(); }
 
 static wc_world *make_world(wc_integrator integrator, int32_t threads, double gz)
 {

@@ -655,7 +655,7 @@ static void tolerance(void)
         CHECK(loose < exact, "tolerance %g: %lld iterations, to round-off %lld", tolerances[k],
               (long long)loose, (long long)exact);
         /* The 65^2 cloth's solve gets the coarse levels' correction (added
-         * in implicit.c's own pass, not through wc_multigrid_add_correction,
+         * in implicit.c's own pass, not through wci_multigrid_add_correction,
          * which test_multigrid checks): 100 iterations to round-off with it,
          * 458 with block-Jacobi alone (measured with the correction taken
          * out), so a solve that lost it fails this bound of 200. */

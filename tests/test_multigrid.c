@@ -189,10 +189,10 @@ static void random_free_vector(const graph *g, double *v)
 static wc_multigrid *build(const graph *g, int threads)
 {
     wc_multigrid *mg = NULL;
-    int failed = wc_multigrid_create(g->n, g->links, g->end_a, g->end_b, g->stretch, g->adj_start,
+    int failed = wci_multigrid_create(g->n, g->links, g->end_a, g->end_b, g->stretch, g->adj_start,
                                      g->adj, &mg);
     CHECK(!failed && mg != NULL, "create: failed %d", failed);
-    if (mg) wc_multigrid_update(mg, g->mass, g->block, g->pin_slot, threads);
+    if (mg) wci_multigrid_update(mg, g->mass, g->block, g->pin_slot, threads);
     return mg;
 }
 
@@ -207,18 +207,18 @@ static void structure(void)
     graph g = make_graph(80, 1);
     wc_multigrid *mg = build(&g, 1);
     if (!mg) return;
-    int32_t levels = wc_multigrid_levels(mg);
+    int32_t levels = wci_multigrid_levels(mg);
     CHECK(levels >= 3, "%d levels for 6400 particles", levels);
     printf("levels for 80 x 80:");
-    for (int32_t k = 0; k < levels; ++k) printf(" %d", wc_multigrid_level_size(mg, k));
+    for (int32_t k = 0; k < levels; ++k) printf(" %d", wci_multigrid_level_size(mg, k));
     printf("\n");
     for (int32_t k = 0; k + 1 < levels; ++k) {
-        int32_t n = wc_multigrid_level_size(mg, k), nc = wc_multigrid_level_size(mg, k + 1);
+        int32_t n = wci_multigrid_level_size(mg, k), nc = wci_multigrid_level_size(mg, k + 1);
         CHECK(nc <= 0.75 * n && nc >= 1, "level %d: %d nodes above %d", k + 1, nc, n);
         int32_t *members = calloc((size_t)nc, sizeof *members);
         int bad = 0;
         for (int32_t i = 0; i < n; ++i) {
-            int32_t a = wc_multigrid_aggregate(mg, k, i);
+            int32_t a = wci_multigrid_aggregate(mg, k, i);
             if (a < 0 || a >= nc) ++bad;
             else ++members[a];
         }
@@ -226,7 +226,7 @@ static void structure(void)
         CHECK(bad == 0, "level %d: %d nodes without an aggregate or empty aggregates", k, bad);
         free(members);
     }
-    wc_multigrid_destroy(mg);
+    wci_multigrid_destroy(mg);
     free_graph(&g);
 }
 
@@ -240,8 +240,8 @@ static void galerkin(void)
     graph g = make_graph(80, 1);
     wc_multigrid *mg = build(&g, 1);
     if (!mg) return;
-    for (int32_t k = 0; k + 1 < wc_multigrid_levels(mg); ++k) {
-        int32_t n = wc_multigrid_level_size(mg, k), nc = wc_multigrid_level_size(mg, k + 1);
+    for (int32_t k = 0; k + 1 < wci_multigrid_levels(mg); ++k) {
+        int32_t n = wci_multigrid_level_size(mg, k), nc = wci_multigrid_level_size(mg, k + 1);
         double *xc = malloc(3 * (size_t)nc * sizeof(double));
         double *x = calloc(3 * (size_t)n, sizeof(double)), *ax = malloc(3 * (size_t)n * sizeof(double));
         double *want = calloc(3 * (size_t)nc, sizeof(double)), *got = malloc(3 * (size_t)nc * sizeof(double));
@@ -249,14 +249,14 @@ static void galerkin(void)
         for (int32_t i = 0; i < n; ++i)
             if (k > 0 || !pinned(&g, i))
                 for (int j = 0; j < 3; ++j)
-                    x[3 * (size_t)i + j] = xc[3 * (size_t)wc_multigrid_aggregate(mg, k, i) + j];
+                    x[3 * (size_t)i + j] = xc[3 * (size_t)wci_multigrid_aggregate(mg, k, i) + j];
         if (k == 0) fine_product(&g, x, ax);
-        else wc_multigrid_level_product(mg, k, x, ax);
+        else wci_multigrid_level_product(mg, k, x, ax);
         for (int32_t i = 0; i < n; ++i)
             if (k > 0 || !pinned(&g, i))
                 for (int j = 0; j < 3; ++j)
-                    want[3 * (size_t)wc_multigrid_aggregate(mg, k, i) + j] += ax[3 * (size_t)i + j];
-        wc_multigrid_level_product(mg, k + 1, xc, got);
+                    want[3 * (size_t)wci_multigrid_aggregate(mg, k, i) + j] += ax[3 * (size_t)i + j];
+        wci_multigrid_level_product(mg, k + 1, xc, got);
         double err = 0.0, norm = 0.0;
         for (size_t j = 0; j < 3 * (size_t)nc; ++j)
             err += (got[j] - want[j]) * (got[j] - want[j]), norm += want[j] * want[j];
@@ -266,7 +266,7 @@ static void galerkin(void)
                sqrt(err / norm));
         free(xc), free(x), free(ax), free(want), free(got);
     }
-    wc_multigrid_destroy(mg);
+    wci_multigrid_destroy(mg);
     free_graph(&g);
 }
 
@@ -283,8 +283,8 @@ static void correction(void)
     random_free_vector(&g, v);
     wc_multigrid *mg = build(&g, 1);
     if (!mg) return;
-    wc_multigrid_add_correction(mg, u, mu, 1);
-    wc_multigrid_add_correction(mg, v, mv, 1);
+    wci_multigrid_add_correction(mg, u, mu, 1);
+    wci_multigrid_add_correction(mg, v, mv, 1);
     double uv = dot(u, mv, len), vu = dot(v, mu, len), uu = dot(u, mu, len);
     CHECK(fabs(uv - vu) <= 1e-12 * sqrt(dot(u, u, len) * dot(mv, mv, len)),
           "u.Mv %.17g, v.Mu %.17g", uv, vu);
@@ -300,12 +300,12 @@ static void correction(void)
     for (int threads = 2; threads <= 4; threads += 2) {
         wc_multigrid *other = build(&g, threads);
         double *mt = calloc(len, sizeof(double));
-        wc_multigrid_add_correction(other, u, mt, threads);
+        wci_multigrid_add_correction(other, u, mt, threads);
         CHECK(memcmp(mt, mu, len * sizeof(double)) == 0, "%d threads: other bits", threads);
         free(mt);
-        wc_multigrid_destroy(other);
+        wci_multigrid_destroy(other);
     }
-    wc_multigrid_destroy(mg);
+    wci_multigrid_destroy(mg);
     free(u), free(v), free(mu), free(mv);
     free_graph(&g);
 }
@@ -327,7 +327,7 @@ static int pcg(const graph *g, const double *jacobi, wc_multigrid *mg, const dou
             for (int j = 0; j < 3; ++j)
                 z[3 * (size_t)i + j] = m[3 * j] * ri[0] + m[3 * j + 1] * ri[1] + m[3 * j + 2] * ri[2];
         }
-        if (mg) wc_multigrid_add_correction(mg, r, z, 1);
+        if (mg) wci_multigrid_add_correction(mg, r, z, 1);
         double rz_next = dot(r, z, len);
         for (size_t k = 0; k < len; ++k) p[k] = z[k] + (it ? rz_next / rz : 0.0) * p[k];
         rz = rz_next;
@@ -359,7 +359,7 @@ static void fewer_iterations(void)
                "the coarse levels\n", pins, plain, with);
         CHECK(plain < 5000 && 2 * with <= plain, "pins %d: %d against %d iterations", pins, with,
               plain);
-        wc_multigrid_destroy(mg);
+        wci_multigrid_destroy(mg);
         free(jacobi), free(b);
         free_graph(&g);
     }
@@ -370,7 +370,7 @@ static void small_cloth(void)
 {
     graph g = make_graph(60, 0); /* 3600 particles */
     wc_multigrid *mg = (wc_multigrid *)&g;
-    int failed = wc_multigrid_create(g.n, g.links, g.end_a, g.end_b, g.stretch, g.adj_start, g.adj,
+    int failed = wci_multigrid_create(g.n, g.links, g.end_a, g.end_b, g.stretch, g.adj_start, g.adj,
                                      &mg);
     CHECK(!failed && mg == NULL, "3600 particles: failed %d, hierarchy %p", failed, (void *)mg);
     free_graph(&g);
@@ -399,17 +399,17 @@ static void out_of_memory(void)
     wc_set_allocator(counting_alloc, counting_free, NULL);
     wc_multigrid *mg = NULL;
     g_allocs = 0, g_live = 0, g_fail_at = -1;
-    int failed = wc_multigrid_create(g.n, g.links, g.end_a, g.end_b, g.stretch, g.adj_start, g.adj,
+    int failed = wci_multigrid_create(g.n, g.links, g.end_a, g.end_b, g.stretch, g.adj_start, g.adj,
                                      &mg);
     long needed = g_allocs;
     CHECK(!failed && mg, "without failures: failed %d", failed);
-    wc_multigrid_destroy(mg);
+    wci_multigrid_destroy(mg);
     CHECK(g_live == 0, "%ld blocks live after destroy", g_live);
     int wrong = 0;
     for (long k = 0; k < needed; ++k) {
         g_allocs = 0, g_live = 0, g_fail_at = k;
         mg = (wc_multigrid *)&g;
-        failed = wc_multigrid_create(g.n, g.links, g.end_a, g.end_b, g.stretch, g.adj_start, g.adj,
+        failed = wci_multigrid_create(g.n, g.links, g.end_a, g.end_b, g.stretch, g.adj_start, g.adj,
                                      &mg);
         if (failed != 1 || mg != NULL || g_live != 0) {
             if (wrong++ < 5)

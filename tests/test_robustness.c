@@ -52,20 +52,20 @@ static void grid_awkward_boxes(void)
         -INFINITY, 0.0, 0.0, INFINITY, 0.05, 0.05,            /* infinite */
     };
     wc_grid g;
-    wc_grid_init(&g);
-    CHECK(wc_grid_build(&g, boxes, 4, 0.1) == WC_OK, "build");
+    memset(&g, 0, sizeof g);
+    CHECK(wci_grid_update(&g, boxes, 4, 0.1) == WC_OK, "build");
     int32_t found[8];
     double q[6] = {0.05, 0.05, 0.05, 0.06, 0.06, 0.06};
-    int32_t n = wc_grid_query(&g, q, found, 8);
+    int32_t n = wci_grid_query(&g, q, found, 8);
     CHECK(n == 3 && found[0] == 0 && found[1] == 2 && found[2] == 3,
           "query finds the ordinary, the everything and the infinite box (%d found)", (int)n);
     double huge[6] = {-1e300, -1e300, -1e300, 1e300, 1e300, 1e300};
-    n = wc_grid_query(&g, huge, found, 8);
+    n = wci_grid_query(&g, huge, found, 8);
     CHECK(n == 3, "a query over everything finds the 3 boxes that are not NaN (%d)", (int)n);
     double nan_box[6] = {NAN, NAN, NAN, NAN, NAN, NAN};
-    n = wc_grid_query(&g, nan_box, found, 8);
+    n = wci_grid_query(&g, nan_box, found, 8);
     CHECK(n >= 0 && n <= 4, "a NaN query returns a count (%d)", (int)n);
-    wc_grid_free(&g);
+    wci_grid_destroy(&g);
 }
 
 /* An empty box (min above max on an axis: the box of triangle corners whose
@@ -84,28 +84,28 @@ static void grid_empty_box(void)
         INFINITY, 0.0, 0.0, -INFINITY, 0.1, 0.1, /* empty along x */
     };
     wc_grid g;
-    wc_grid_init(&g);
-    CHECK(wc_grid_build(&g, boxes, 5, 0.1) == WC_OK, "build");
+    memset(&g, 0, sizeof g);
+    CHECK(wci_grid_update(&g, boxes, 5, 0.1) == WC_OK, "build");
     int32_t found[8];
     double everything[6] = {-10.0, -10.0, -10.0, 10.0, 10.0, 10.0};
-    int32_t n = wc_grid_query(&g, everything, found, 8);
+    int32_t n = wci_grid_query(&g, everything, found, 8);
     CHECK(n == 3 && found[0] == 0 && found[1] == 2 && found[2] == 3,
           "a query over everything finds the three boxes that are not empty (%d found)", (int)n);
     double q[6] = {0.21, 0.21, 0.21, 0.22, 0.22, 0.22};
-    n = wc_grid_query(&g, q, found, 8);
+    n = wci_grid_query(&g, q, found, 8);
     CHECK(n == 2 && found[0] == 2 && found[1] == 3, "a small query finds boxes 2 and 3 (%d found)", (int)n);
     /* empty along x, the whole double range along y and z: the query
      * looped over 2e9 x 2e9 cells of y and z (a fuzz input's timeout) */
     double empty_query[6] = {INFINITY, -1e300, -1e300, -INFINITY, 1e300, 1e300};
-    n = wc_grid_query(&g, empty_query, found, 8);
+    n = wci_grid_query(&g, empty_query, found, 8);
     CHECK(n == 0, "an empty query finds nothing (%d found)", (int)n);
-    wc_grid_free(&g);
+    wci_grid_destroy(&g);
     double wide_empty[6] = {INFINITY, -1e300, -1e300, -INFINITY, 1e300, 1e300};
-    wc_grid_init(&g);
-    CHECK(wc_grid_build(&g, wide_empty, 1, 0.1) == WC_OK, "build with an empty box spanning y and z");
-    n = wc_grid_query(&g, everything, found, 8);
+    memset(&g, 0, sizeof g);
+    CHECK(wci_grid_update(&g, wide_empty, 1, 0.1) == WC_OK, "build with an empty box spanning y and z");
+    n = wci_grid_query(&g, everything, found, 8);
     CHECK(n == 0, "the empty box is found (%d)", (int)n);
-    wc_grid_free(&g);
+    wci_grid_destroy(&g);
 }
 
 /* A mesh collider moved from near the most negative double to near the
@@ -134,7 +134,7 @@ static void collider_across_the_doubles(void)
     wc_collider *c = w->colliders[id];
     int bad = 0;
     for (int step = 1; step <= 4; ++step) {
-        CHECK(wc_collider_begin_step(c, step / 4.0) == WC_OK, "begin step %d", step);
+        CHECK(wci_collider_begin_step(c, step / 4.0) == WC_OK, "begin step %d", step);
         for (int k = 0; k < 9; ++k) bad += !isfinite(c->next[k]);
     }
     CHECK(bad == 0, "%d collider coordinates not finite across the substeps", bad);

@@ -19,7 +19,7 @@
  *      rest on it with no intersection in any frame, the same bits on 1 and
  *      4 threads; with collide_with_cloths = 0 on the thrown one it passes
  *      through (the checker sees it), so the flag is what keeps them apart.
- * (a)-(d) drive wc_self_collide directly on a cloth's internal arrays, with
+ * (a)-(d) drive wci_self_collide directly on a cloth's internal arrays, with
  * a brute-force check (every vertex-face and edge-edge pair, no broadphase)
  * of what remains. */
 #include <math.h>
@@ -123,7 +123,7 @@ static int32_t count_ccd_collisions(const wc_cloth *c, double tol)
             if (v == tri[0] || v == tri[1] || v == tri[2]) continue;
             double p0[3], p1[3], time, bary[3];
             get(c->x, c->y, c->z, v, p0), get(c->nx, c->ny, c->nz, v, p1);
-            hits += wc_ccd_point_triangle(p0, p1, a0, a1, b0, b1, c0, c1, tol, &time, bary);
+            hits += wci_ccd_point_triangle(p0, p1, a0, a1, b0, b1, c0, c1, tol, &time, bary);
         }
     }
     int32_t *edges = malloc(sizeof(int32_t) * 6 * (size_t)nt);
@@ -138,7 +138,7 @@ static int32_t count_ccd_collisions(const wc_cloth *c, double tol)
                 get(c->x, c->y, c->z, ids[j], p[j][0]);
                 get(c->nx, c->ny, c->nz, ids[j], p[j][1]);
             }
-            hits += wc_ccd_edge_edge(p[0][0], p[0][1], p[1][0], p[1][1], p[2][0], p[2][1], p[3][0],
+            hits += wci_ccd_edge_edge(p[0][0], p[0][1], p[1][0], p[1][1], p[2][0], p[2][1], p[3][0],
                                      p[3][1], tol, &time, &s, &u);
         }
     free(edges);
@@ -175,14 +175,14 @@ static void test_vertex_face(void)
     CHECK(count_ccd_collisions(c, 1e-9) > 0, "setup: the apex should pass through A");
     wc_step_stats stats;
     memset(&stats, 0, sizeof stats);
-    wc_status s = wc_self_collide(c, 0.01, 1, &stats);
-    CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
+    wc_status s = wci_self_collide(c, 0.01, 1, &stats);
+    CHECK(s == WC_OK, "wci_self_collide: %d", (int)s);
     double p[3], a[3], b[3], q[3], bary[3];
     get(c->nx, c->ny, c->nz, 3, p);
     get(c->nx, c->ny, c->nz, 0, a);
     get(c->nx, c->ny, c->nz, 1, b);
     get(c->nx, c->ny, c->nz, 2, q);
-    double d = sqrt(wc_point_triangle_closest(p, a, b, q, bary));
+    double d = sqrt(wci_point_triangle_closest(p, a, b, q, bary));
     double plane = p[2] - (bary[0] * a[2] + bary[1] * b[2] + bary[2] * q[2]);
     printf("vertex-face: apex ends %.6g m above A (thickness %g), contacts %d, fail-safe %d\n",
            plane, h, (int)stats.cloth_contacts, (int)stats.failsafe_particles);
@@ -219,7 +219,7 @@ static void test_pushed_particle_at_rest(void)
     wc_world *w = new_world(1);
     wc_cloth *c = apex_over_face(w, h);
     if (!c) return;
-    double band = wc_self_thickness(c);
+    double band = wci_self_thickness(c);
     clear_contacts(c);
     /* the apex starts the step at rest on the band over A, and a collider
      * pass pushed it 0.2 band down */
@@ -231,7 +231,7 @@ static void test_pushed_particle_at_rest(void)
     c->history_override[3] = 1;
     wc_step_stats stats;
     memset(&stats, 0, sizeof stats);
-    CHECK(wc_self_collide(c, dt, 1, &stats) == WC_OK, "wc_self_collide failed");
+    CHECK(wci_self_collide(c, dt, 1, &stats) == WC_OK, "wci_self_collide failed");
     double fastest = 0.0;
     for (int32_t i = 0; i < 6; ++i) {
         double prev[3] = {c->x[i], c->y[i], c->z[i]};
@@ -270,14 +270,14 @@ static void test_edge_edge(void)
     CHECK(count_ccd_collisions(c, 1e-9) > 0, "setup: the edges should cross");
     wc_step_stats stats;
     memset(&stats, 0, sizeof stats);
-    wc_status s = wc_self_collide(c, 0.01, 1, &stats);
-    CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
+    wc_status s = wci_self_collide(c, 0.01, 1, &stats);
+    CHECK(s == WC_OK, "wci_self_collide: %d", (int)s);
     double p0[3], p1[3], q0[3], q1[3], u, v;
     get(c->nx, c->ny, c->nz, 0, p0);
     get(c->nx, c->ny, c->nz, 1, p1);
     get(c->nx, c->ny, c->nz, 3, q0);
     get(c->nx, c->ny, c->nz, 4, q1);
-    double d = sqrt(wc_segment_segment_closest(p0, p1, q0, q1, &u, &v));
+    double d = sqrt(wci_segment_segment_closest(p0, p1, q0, q1, &u, &v));
     double gap = (q0[2] + (q1[2] - q0[2]) * v) - (p0[2] + (p1[2] - p0[2]) * u);
     printf("edge-edge: B's edge ends %.6g m above A's (thickness %g), contacts %d, fail-safe %d\n",
            gap, h, (int)stats.cloth_contacts, (int)stats.failsafe_particles);
@@ -311,7 +311,7 @@ static void test_pinned_face(void)
     clear_contacts(c);
     wc_step_stats stats;
     memset(&stats, 0, sizeof stats);
-    wc_self_collide(c, 0.01, 1, &stats);
+    wci_self_collide(c, 0.01, 1, &stats);
     for (int32_t i = 0; i < 3; ++i)
         CHECK(c->nx[i] == c->x[i] && c->ny[i] == c->y[i] && c->nz[i] == c->z[i],
               "pinned particle %d moved", (int)i);
@@ -378,8 +378,8 @@ static void test_failsafe(void)
     int32_t before = count_ccd_collisions(c, 1e-9);
     wc_step_stats stats;
     memset(&stats, 0, sizeof stats);
-    wc_status s = wc_self_collide(c, 0.01, 1, &stats);
-    CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
+    wc_status s = wci_self_collide(c, 0.01, 1, &stats);
+    CHECK(s == WC_OK, "wci_self_collide: %d", (int)s);
     int32_t after = count_ccd_collisions(c, 1e-9);
     int32_t at_start = 0, bad_history = 0;
     for (int32_t i = 0; i < c->particle_count; ++i) {
@@ -447,8 +447,8 @@ static void test_threads(void)
         n = (size_t)c->particle_count;
         wc_step_stats stats;
         memset(&stats, 0, sizeof stats);
-        wc_status s = wc_self_collide(c, 0.001, thread_counts[r], &stats);
-        CHECK(s == WC_OK, "wc_self_collide: %d", (int)s);
+        wc_status s = wci_self_collide(c, 0.001, thread_counts[r], &stats);
+        CHECK(s == WC_OK, "wci_self_collide: %d", (int)s);
         /* Everything the call writes, as bits. */
         double *out = malloc(sizeof(double) * 11 * n);
         const double *arrays[9] = {c->nx, c->ny, c->nz, c->qx, c->qy, c->qz, c->normal_x, c->normal_y, c->normal_z};

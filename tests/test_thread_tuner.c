@@ -34,11 +34,11 @@ static run_log drive(wc_thread_tuner *t, int32_t steps, int32_t free_cores, doub
     run_log log;
     memset(&log, 0, sizeof log);
     for (int32_t s = 0; s < steps; ++s) {
-        int32_t n = wc_thread_tuner_threads(t);
+        int32_t n = wci_thread_tuner_threads(t);
         CHECK(n >= 1 && n <= t->most, "step %d: %d threads of at most %d", s, n, t->most);
         ++log.steps_at[n];
         log.last = n;
-        wc_thread_tuner_record(t, step_time(n, free_cores, work, tick));
+        wci_thread_tuner_record(t, step_time(n, free_cores, work, tick));
     }
     return log;
 }
@@ -48,7 +48,7 @@ static run_log drive(wc_thread_tuner *t, int32_t steps, int32_t free_cores, doub
 static void idle_machine_keeps_two(void)
 {
     wc_thread_tuner t;
-    wc_thread_tuner_create(&t, 2, 1);
+    wci_thread_tuner_create(&t, 2, 1);
     run_log log = drive(&t, 5000, 2, 0.020, 0.004);
     printf("idle 2 cores: %d steps on 2 threads, %d on 1\n", log.steps_at[2], log.steps_at[1]);
     CHECK(log.last == 2, "ended on %d threads", log.last);
@@ -64,7 +64,7 @@ static void idle_machine_keeps_two(void)
 static void busy_core_moves_to_one_and_back(void)
 {
     wc_thread_tuner t;
-    wc_thread_tuner_create(&t, 2, 1);
+    wci_thread_tuner_create(&t, 2, 1);
     run_log busy = drive(&t, 2000, 1, 0.020, 0.030);
     printf("one core busy: %d steps on 2 threads, %d on 1\n", busy.steps_at[2], busy.steps_at[1]);
     CHECK(busy.last == 1, "busy: ended on %d threads", busy.last);
@@ -81,10 +81,10 @@ static void busy_core_moves_to_one_and_back(void)
 static void slowdown_brings_the_probe_forward(void)
 {
     wc_thread_tuner t;
-    wc_thread_tuner_create(&t, 2, 1);
+    wci_thread_tuner_create(&t, 2, 1);
     drive(&t, 20000, 2, 0.020, 0.030);
-    CHECK(t.period == 1024 && wc_thread_tuner_threads(&t) == 2, "settled: period %d, %d threads",
-          (int)t.period, (int)wc_thread_tuner_threads(&t));
+    CHECK(t.period == 1024 && wci_thread_tuner_threads(&t) == 2, "settled: period %d, %d threads",
+          (int)t.period, (int)wci_thread_tuner_threads(&t));
     run_log busy = drive(&t, 100, 1, 0.020, 0.030);
     printf("busy after settling: %d of 100 steps on 2 threads\n", busy.steps_at[2]);
     /* 3 steps to see the slowdown, a probe's 4 on the chosen count, and at
@@ -98,7 +98,7 @@ static void slowdown_brings_the_probe_forward(void)
 static void sixteen_threads_find_the_free_cores(void)
 {
     wc_thread_tuner t;
-    wc_thread_tuner_create(&t, 16, 1);
+    wci_thread_tuner_create(&t, 16, 1);
     run_log log = drive(&t, 3000, 5, 0.080, 0.030);
     printf("16 threads, 5 free cores: last %d; steps on 16/8/4/2/1: %d/%d/%d/%d/%d\n", log.last,
            log.steps_at[16], log.steps_at[8], log.steps_at[4], log.steps_at[2], log.steps_at[1]);
@@ -110,18 +110,18 @@ static void sixteen_threads_find_the_free_cores(void)
 static void ties_go_to_fewer_threads(void)
 {
     wc_thread_tuner t;
-    wc_thread_tuner_create(&t, 2, 1);
-    for (int32_t s = 0; s < 500; ++s) wc_thread_tuner_record(&t, 0.01);
+    wci_thread_tuner_create(&t, 2, 1);
+    for (int32_t s = 0; s < 500; ++s) wci_thread_tuner_record(&t, 0.01);
     CHECK(t.chosen == 1, "equal times: %d threads chosen", (int)t.chosen);
 }
 
 static void off_or_one_thread_never_changes(void)
 {
     wc_thread_tuner t;
-    wc_thread_tuner_create(&t, 4, 0);
+    wci_thread_tuner_create(&t, 4, 0);
     run_log log = drive(&t, 500, 1, 0.02, 0.03);
     CHECK(log.steps_at[4] == 500, "adapt off: %d of 500 steps on 4 threads", log.steps_at[4]);
-    wc_thread_tuner_create(&t, 1, 1);
+    wci_thread_tuner_create(&t, 1, 1);
     log = drive(&t, 500, 4, 0.02, 0.03);
     CHECK(log.steps_at[1] == 500, "one thread: %d of 500 steps on it", log.steps_at[1]);
 }

@@ -405,13 +405,13 @@ static void test_tension_only(void)
     const double g0[3] = {0.0, 0.0, 0.0};
 
     /* At rest, and uniformly compressed to half size: no force at all. */
-    wc_forces_compute(c, g0, 1);
+    wci_forces_compute(c, g0, 1);
     for (int i = 0; i < 3; ++i)
         CHECK(c->fx[i] == 0.0 && c->fy[i] == 0.0 && c->fz[i] == 0.0, "rest force on %d", i);
     double half[9];
     for (int k = 0; k < 9; ++k) half[k] = 0.5 * xyz[k] + 0.1;
     CHECK(wc_cloth_set_positions(w, id, half, 3) == WC_OK, "set_positions");
-    wc_forces_compute(c, g0, 1);
+    wci_forces_compute(c, g0, 1);
     for (int i = 0; i < 3; ++i)
         CHECK(c->fx[i] == 0.0 && c->fy[i] == 0.0 && c->fz[i] == 0.0,
               "compressed triangle: force on %d = (%g, %g, %g)", i, c->fx[i], c->fy[i], c->fz[i]);
@@ -419,7 +419,7 @@ static void test_tension_only(void)
     /* One link compressed, two stretched. */
     double def_xyz[9] = {0, 0, 0, 0.9, 0, 0, 0, 1.2, 0.3};
     CHECK(wc_cloth_set_positions(w, id, def_xyz, 3) == WC_OK, "set_positions");
-    wc_forces_compute(c, g0, 1);
+    wci_forces_compute(c, g0, 1);
     double expect[9] = {0};
     const wc_link_set *ls = &c->topology.stretch;
     for (int32_t e = 0; e < ls->count; ++e) {

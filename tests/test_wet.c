@@ -699,7 +699,7 @@ static self_result self_run(double wetness)
             const wc_cloth *c = w->cloths[cl];
             double fx[N], fy[N], fz[N];
             memset(fx, 0, sizeof fx), memset(fy, 0, sizeof fy), memset(fz, 0, sizeof fz);
-            wc_wet_self_adhesion(c, fx, fy, fz);
+            wci_wet_self_adhesion(c, fx, fy, fz);
             r.pairs = c->adhesive_count;
             for (int i = 0; i < N; ++i) {
                 r.force_sum[0] += fx[i], r.force_sum[1] += fy[i], r.force_sum[2] += fz[i];

@@ -189,7 +189,7 @@ static void group_forces(wc_world *w, double f[2][3], double *abs_sum)
         memset(c->fx, 0, n * sizeof *c->fx), memset(c->fy, 0, n * sizeof *c->fy);
         memset(c->fz, 0, n * sizeof *c->fz);
     }
-    wc_cloth_group_adhesion(w->group, w->cloths);
+    wci_cloth_group_adhesion(w->group, w->cloths);
     for (int k = 0; k < 2; ++k) {
         const wc_cloth *c = w->cloths[k];
         f[k][0] = f[k][1] = f[k][2] = 0.0;

@@ -22,9 +22,9 @@
  * sphere (it wraps it: 262 particles in contact at the end against 45 dry,
  * and four times the feature-pass pushes per step), which is collision
  * work the dry cloth does not have. The wet code itself is a few per cent
- * of a wet step: `perf record` on the 20 x 20 wet run puts wc_wet_forces,
- * the contact hold (wc_wet_hold_contacts, mesh_nearest) and
- * wc_wet_mark_stuck at 3.2 % of its samples together.
+ * of a wet step: `perf record` on the 20 x 20 wet run puts wci_wet_forces,
+ * the contact hold (wci_wet_hold_contacts, mesh_nearest) and
+ * wci_wet_mark_stuck at 3.2 % of its samples together.
  * The configurations run interleaved, `repeats` times each; the figure is
  * the fastest run of each (the least disturbed by other load), in
  * microseconds per step, and the ratio wet / dry of those. */
