@@ -34,6 +34,11 @@
 /* Dot products sum fixed blocks of this many particles, then the blocks in
  * order: the same rounding for any thread count. */
 #define BLOCK 512
+/* The sets of partial sums: r . r (and b . b), p . A p, r . z. */
+#define PARTIAL_RR 0
+#define PARTIAL_PQ 1
+#define PARTIAL_RZ 2
+#define PARTIAL_SETS 3
 
 struct wc_implicit_state {
     int32_t n, links, blocks;
@@ -46,9 +51,13 @@ struct wc_implicit_state {
     /// and the inverse of the whole 3 x 3 diagonal block (6 values).
     double *mass_diag, *precond;
     /// 3n vectors, xyz interleaved: start velocity, known dv of pins,
-    /// right-hand side, solution, residual, preconditioned residual,
-    /// search direction, matrix times direction.
-    double *v0, *fixed, *rhs, *y, *r, *z, *p, *q;
+    /// right-hand side, solution, residual (two: an iteration writes the
+    /// new one while the coarse levels read the old one), preconditioned
+    /// residual, search direction, matrix times direction.
+    double *v0, *fixed, *rhs, *y, *r, *r_next, *z, *p, *q;
+    /// Per block, the sums of the dot products: three sets (PARTIAL_*), so
+    /// that a thread that starts the next sum cannot overwrite one that
+    /// another thread has not yet added up.
     double *partial;
     /// Per link, scratch of the product with the matrix: B (in_a - in_b).
     double *link_product;
@@ -63,7 +72,8 @@ void wci_implicit_state_destroy(wc_implicit_state *s)
 {
     if (!s) return;
     double *arrays[] = {s->block, s->kv, s->mass_diag, s->precond, s->v0, s->fixed, s->rhs,
-                        s->y, s->r, s->z, s->p, s->q, s->partial, s->link_product};
+                        s->y, s->r, s->r_next, s->z, s->p, s->q, s->partial,
+                        s->link_product};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wci_free(arrays[i]);
     wci_free(s->end_a);
     wci_free(s->end_b);
@@ -86,11 +96,12 @@ wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
     s->kv = wci_alloc_array(3 * links, sizeof(double));
     s->mass_diag = wci_alloc_array(n, sizeof(double));
     s->precond = wci_alloc_array(6 * n, sizeof(double));
-    double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r, &s->z, &s->p, &s->q};
+    double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r,
+                          &s->r_next, &s->z, &s->p, &s->q};
     int ok = 1;
     for (size_t i = 0; i < sizeof vectors / sizeof vectors[0]; ++i)
         ok &= (*vectors[i] = wci_alloc_array(3 * n, sizeof(double))) != NULL;
-    s->partial = wci_alloc_array((size_t)s->blocks, sizeof(double));
+    s->partial = wci_alloc_array(PARTIAL_SETS * (size_t)s->blocks, sizeof(double));
     s->link_product = wci_alloc_array(3 * links + 1, sizeof(double));
     if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
         !s->partial || !s->link_product) {
@@ -141,14 +152,18 @@ typedef struct implicit_pass {
     /* the part of the velocity change that the positions take: x+ = x + h
      * (v0 + share dv), share = (h + h_prev) / 2h (see wci_integrate_implicit) */
     double share;
-    /* dot: a . b; apply: out = A in; updates: the factor */
-    const double *a, *b, *in;
+    /* apply: out = A in; updates: the factor */
+    const double *in;
     double *out;
     double factor;
     /* precondition: the coarse levels' solution per aggregate and each
      * particle's aggregate, NULL without coarse levels */
     const double *coarse;
     const int32_t *aggregate;
+    /* where a summing loop puts its per-block sums */
+    double *partial;
+    /* the solve's residual and where its update goes (they swap) */
+    double *r, *r_next;
 } implicit_pass;
 
 static void set_block(double *b, double along, double across, double ux, double uy, double uz)
@@ -304,10 +319,10 @@ static void block_bounds(const wc_implicit_state *s, int64_t block, int64_t *beg
     *end = *begin + BLOCK < s->n ? *begin + BLOCK : s->n;
 }
 
-static double block_sum(const wc_implicit_state *s)
+static double block_sum(const wc_implicit_state *s, const double *partial)
 {
     double total = 0.0;
-    for (int32_t k = 0; k < s->blocks; ++k) total += s->partial[k];
+    for (int32_t k = 0; k < s->blocks; ++k) total += partial[k];
     return total;
 }
 
@@ -366,7 +381,7 @@ static int apply_range(void *context, int64_t first, int64_t last)
             sum += vi[1] * oy;
             sum += vi[2] * oz;
         }
-        s->partial[block] = sum;
+        pass->partial[block] = sum;
     }
     return 0;
 }
@@ -379,7 +394,7 @@ static int precondition_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
     wc_implicit_state *s = pass->state;
-    const double *r = s->r, *precond = s->precond, *coarse = pass->coarse;
+    const double *r = pass->r, *precond = s->precond, *coarse = pass->coarse;
     const int32_t *aggregate = pass->aggregate, *pin_slot = pass->cloth->pin_slot;
     double *z = s->z;
     for (int64_t block = first; block < last; ++block) {
@@ -398,28 +413,31 @@ static int precondition_range(void *context, int64_t first, int64_t last)
             sum += ri[1] * zi[1];
             sum += ri[2] * zi[2];
         }
-        s->partial[block] = sum;
+        pass->partial[block] = sum;
     }
     return 0;
 }
 
-/* a . b over the 3n values. */
-static int dot_range(void *context, int64_t first, int64_t last)
+/* The solve's start, y = 0 and r = b; sums b . b. */
+static int start_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
     wc_implicit_state *s = pass->state;
-    const double *a = pass->a, *b = pass->b;
     for (int64_t block = first; block < last; ++block) {
         int64_t begin, end;
         block_bounds(s, block, &begin, &end);
         double sum = 0.0;
-        for (int64_t i = 3 * begin; i < 3 * end; ++i) sum += a[i] * b[i];
-        s->partial[block] = sum;
+        for (int64_t i = 3 * begin; i < 3 * end; ++i) {
+            s->y[i] = 0.0;
+            pass->r[i] = s->rhs[i];
+            sum += s->rhs[i] * s->rhs[i];
+        }
+        pass->partial[block] = sum;
     }
     return 0;
 }
 
-/* y += alpha p; r -= alpha q; sums r . r. */
+/* y += alpha p; r_next = r - alpha q; sums r_next . r_next. */
 static int update_solution_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
@@ -431,10 +449,10 @@ static int update_solution_range(void *context, int64_t first, int64_t last)
         double sum = 0.0;
         for (int64_t i = 3 * begin; i < 3 * end; ++i) {
             s->y[i] += alpha * s->p[i];
-            s->r[i] -= alpha * s->q[i];
-            sum += s->r[i] * s->r[i];
+            pass->r_next[i] = pass->r[i] - alpha * s->q[i];
+            sum += pass->r_next[i] * pass->r_next[i];
         }
-        s->partial[block] = sum;
+        pass->partial[block] = sum;
     }
     return 0;
 }
@@ -453,37 +471,59 @@ static int update_direction_range(void *context, int64_t first, int64_t last)
     return 0;
 }
 
-/* One loop of an iteration over the blocks. */
-static void run_blocks(implicit_pass *pass, wc_range_fn body, int threads)
+/* The first direction, p = z. */
+static int first_direction_range(void *context, int64_t first, int64_t last)
+{
+    const implicit_pass *pass = context;
+    wc_implicit_state *s = pass->state;
+    int64_t begin, end, unused;
+    block_bounds(s, first, &begin, &unused);
+    block_bounds(s, last - 1, &unused, &end);
+    memcpy(s->p + 3 * begin, s->z + 3 * begin, 3 * (size_t)(end - begin) * sizeof(double));
+    return 0;
+}
+
+/* The solve runs in one team (parallel.h): each thread takes the same
+ * slices of the blocks and of the links in every iteration, a barrier
+ * stands wherever a loop reads what other threads wrote, and every thread
+ * adds up the block sums itself in block order: the same scalars, and so
+ * the same decisions, on every thread. The blocks split from
+ * WC_PARALLEL_MIN particles up, as the other per-particle loops do. */
+static void team_blocks(implicit_pass *pass, const wc_team *team, wc_range_fn body, int set)
 {
     wc_implicit_state *s = pass->state;
-    wci_parallel_for(s->blocks, wc_threads_for(s->n, threads), body, pass);
+    int64_t begin, end;
+    wc_team_slice(team, s->blocks, team->threads > 1 && s->n >= WC_PARALLEL_MIN, &begin, &end);
+    pass->partial = s->partial + (size_t)set * (size_t)s->blocks;
+    if (begin < end) body(pass, begin, end);
 }
 
-/* The same for a loop that sums into partial[]: returns the sum. */
-static double summed_blocks(implicit_pass *pass, wc_range_fn body, int threads)
+/* The sum of a set, after the barrier that follows the loop filling it. */
+static double set_sum(const wc_implicit_state *s, int set)
 {
-    run_blocks(pass, body, threads);
-    return block_sum(pass->state);
-}
-
-static double dot(implicit_pass *pass, const double *a, const double *b, int threads)
-{
-    pass->a = a, pass->b = b;
-    return summed_blocks(pass, dot_range, threads);
+    return block_sum(s, s->partial + (size_t)set * (size_t)s->blocks);
 }
 
 /* z = the preconditioner applied to r: block-Jacobi, plus the coarse
- * levels' correction on a large cloth. Returns r . z. */
-static double precondition(implicit_pass *pass, int threads)
+ * levels' correction on a large cloth; the first time also p = z. Returns
+ * r . z. The coarse levels read r as r_old - alpha q (r_old: the residual
+ * before this iteration's update, complete, as q is; q NULL on the first
+ * call, r_old then r itself), so they run in the same phase as the update
+ * of r, whose rows block-Jacobi reads on the thread that wrote them. */
+static double precondition(implicit_pass *pass, const wc_team *team, int first,
+                           const double *r_old, const double *q, double alpha)
 {
     wc_implicit_state *s = pass->state;
     if (s->multigrid) {
-        wci_multigrid_coarse_solve(s->multigrid, s->r, threads);
+        wci_multigrid_coarse_solve_team(s->multigrid, r_old, q, alpha, team);
+        wci_team_barrier(team);
         pass->coarse = wci_multigrid_coarse_solution(s->multigrid);
         pass->aggregate = wci_multigrid_fine_aggregates(s->multigrid);
     }
-    return summed_blocks(pass, precondition_range, threads);
+    team_blocks(pass, team, precondition_range, PARTIAL_RZ);
+    if (first) team_blocks(pass, team, first_direction_range, PARTIAL_RZ);
+    wci_team_barrier(team);
+    return set_sum(s, PARTIAL_RZ);
 }
 
 /* The mass the solve's free particles carry, kg: with the step's
@@ -512,6 +552,59 @@ static double sum_of(const double *values, int count)
     return sum;
 }
 
+typedef struct solve_pass {
+    const implicit_pass *pass;
+    /* velocity_tolerance^2 times the free mass, 0 without a tolerance */
+    double bound;
+} solve_pass;
+
+static void solve_body(void *context, const wc_team *team)
+{
+    const solve_pass *shared = context;
+    implicit_pass pass = *shared->pass; /* each thread's own: loops change its fields */
+    wc_implicit_state *s = pass.state;
+    pass.r = s->r, pass.r_next = s->r_next;
+    team_blocks(&pass, team, start_range, PARTIAL_RR);
+    wci_team_barrier(team);
+    double bb = set_sum(s, PARTIAL_RR), rr = bb, bound = shared->bound;
+    int32_t it = 0;
+    if (bb > 0.0) {
+        double rz = precondition(&pass, team, 1, pass.r, NULL, 0.0);
+        double decrease[ESTIMATE_DELAY] = {0.0};
+        int64_t link_begin, link_end;
+        wc_team_slice(team, s->links, team->threads > 1, &link_begin, &link_end);
+        pass.in = s->p, pass.out = s->q;
+        for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
+            if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
+                break;
+            if (link_begin < link_end) link_products_range(&pass, link_begin, link_end);
+            wci_team_barrier(team);
+            team_blocks(&pass, team, apply_range, PARTIAL_PQ);
+            wci_team_barrier(team);
+            double pq = set_sum(s, PARTIAL_PQ);
+            /* A is positive definite, so pq > 0 unless p = 0 or something
+             * is not finite: then stop, the caller checks the result */
+            if (!(pq > 0.0) || !isfinite(pq)) break;
+            double alpha = rz / pq;
+            decrease[it % ESTIMATE_DELAY] = alpha * rz;
+            pass.factor = alpha;
+            team_blocks(&pass, team, update_solution_range, PARTIAL_RR);
+            double *r_old = pass.r;
+            pass.r = pass.r_next, pass.r_next = r_old;
+            double rz_next = precondition(&pass, team, 0, r_old, s->q, alpha);
+            rr = set_sum(s, PARTIAL_RR);
+            pass.factor = rz_next / rz;
+            team_blocks(&pass, team, update_direction_range, PARTIAL_RR);
+            wci_team_barrier(team);
+            rz = rz_next;
+        }
+    }
+    if (team->thread == 0) {
+        s->last_iterations = it;
+        s->last_residual = bb > 0.0 ? sqrt(rr / bb) : 0.0;
+    }
+}
+
 /* Preconditioned conjugate gradients on A y = rhs from y = 0, until the
  * residual is 1e-8 of the right-hand side or, when velocity_tolerance > 0,
  * the error's estimated energy norm is at most velocity_tolerance^2 times
@@ -520,43 +613,16 @@ static double sum_of(const double *values, int count)
  * Why not a looser relative residual: on stiff cloth the right-hand side
  * is mostly stiff link forces that the solution cancels, so a residual
  * small against it can still leave a large error in the soft modes (a
- * relative 1e-5 broke the stiff cloth's energy test). */
+ * relative 1e-5 broke the stiff cloth's energy test). The whole solve is
+ * one team (a team of one is a plain call); the links split from
+ * WC_PARALLEL_MIN links up, as before. */
 static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
 {
-    wc_implicit_state *s = pass->state;
-    size_t bytes = 3 * (size_t)s->n * sizeof(double);
-    memset(s->y, 0, bytes);
-    memcpy(s->r, s->rhs, bytes);
-    double bb = dot(pass, s->rhs, s->rhs, threads), rr = bb;
-    int32_t it = 0;
-    if (bb > 0.0) {
-        double rz = precondition(pass, threads);
-        memcpy(s->p, s->z, bytes);
-        double bound = velocity_tolerance > 0.0 ? velocity_tolerance * velocity_tolerance *
-                                                      free_mass(pass)
-                                                : 0.0;
-        double decrease[ESTIMATE_DELAY] = {0.0};
-        for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
-            if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
-                break;
-            pass->in = s->p, pass->out = s->q;
-            wci_parallel_for(s->links, wc_threads_for(s->links, threads), link_products_range, pass);
-            double pq = summed_blocks(pass, apply_range, threads);
-            /* A is positive definite, so pq > 0 unless p = 0 or something
-             * is not finite: then stop, the caller checks the result */
-            if (!(pq > 0.0) || !isfinite(pq)) break;
-            double alpha = rz / pq;
-            decrease[it % ESTIMATE_DELAY] = alpha * rz;
-            pass->factor = alpha;
-            rr = summed_blocks(pass, update_solution_range, threads);
-            double rz_next = precondition(pass, threads);
-            pass->factor = rz_next / rz;
-            run_blocks(pass, update_direction_range, threads);
-            rz = rz_next;
-        }
-    }
-    s->last_iterations = it;
-    s->last_residual = bb > 0.0 ? sqrt(rr / bb) : 0.0;
+    double bound = velocity_tolerance > 0.0
+                       ? velocity_tolerance * velocity_tolerance * free_mass(pass)
+                       : 0.0;
+    solve_pass shared = {pass, bound};
+    wci_parallel_team(wc_threads_for(pass->state->links, threads), solve_body, &shared);
 }
 
 /* First particle whose right-hand side is not finite, -1 if none. Forces
@@ -620,7 +686,7 @@ int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doub
      * backward Euler. */
     double h_prev = c->has_history ? c->dt_prev : 0.0;
     implicit_pass pass = {c, s, dt, pin_fraction, (dt + h_prev) / (2.0 * dt),
-                          NULL, NULL, NULL, NULL, 0.0, NULL, NULL};
+                          NULL, NULL, 0.0, NULL, NULL, NULL, NULL, NULL};
     wci_parallel_for(n, particle_threads, start_velocities_range, &pass);
     wci_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
     wci_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);

@@ -20,12 +20,11 @@
  * Laplacian-like matrix best. */
 #define SMOOTHING_WEIGHT (2.0 / 3.0)
 #define COARSEST_SWEEPS 4
-/* A level's loops run on the world's threads from this many nodes up (the
- * fine level's count for the restriction, which reads the fine level), far
- * below WC_PARALLEL_MIN: every CG iteration runs a dozen of them per level,
- * back to back with the solve's own parallel loops, and left on one thread
- * the first coarse level of a 10,201-particle cloth (1,133 nodes) had the
- * other thread waiting through them. */
+/* A level's loops (the restriction to it too) split across the solve's
+ * threads from this many nodes up, far below WC_PARALLEL_MIN: every CG
+ * iteration runs them back to back with the solve's own loops, and left on
+ * one thread the first coarse level of a 10,201-particle cloth (1,133
+ * nodes) had the other thread waiting through them. */
 #define LEVEL_PARALLEL_MIN 256
 
 typedef struct level {
@@ -43,8 +42,9 @@ typedef struct level {
      * aggregate's nodes (CSR), each coarse link's fine links (CSR) */
     int32_t *agg, *member_start, *members, *fine_start, *fine_links;
     /* cycle vectors, 3 per node (coarse levels): solution, right-hand
-     * side, residual */
-    double *x, *b, *r;
+     * side, residual, and the solution after the last sweep of a level
+     * above the coarsest (cycle_solution) */
+    double *x, *b, *r, *post;
 } level;
 
 struct wc_multigrid {
@@ -57,7 +57,7 @@ static void level_free(level *l)
     for (int k = 0; k < 4; ++k) wci_free(l->own_ints[k]);
     int32_t *ints[] = {l->agg, l->member_start, l->members, l->fine_start, l->fine_links};
     for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) wci_free(ints[k]);
-    double *doubles[] = {l->diag, l->own_block, l->inv, l->x, l->b, l->r};
+    double *doubles[] = {l->diag, l->own_block, l->inv, l->x, l->b, l->r, l->post};
     for (size_t k = 0; k < sizeof doubles / sizeof doubles[0]; ++k) wci_free(doubles[k]);
 }
 
@@ -243,7 +243,8 @@ static int allocate_values(level *c)
     c->x = wci_alloc_array(3 * n, sizeof(double));
     c->b = wci_alloc_array(3 * n, sizeof(double));
     c->r = wci_alloc_array(3 * n, sizeof(double));
-    return !c->diag || !c->inv || !c->own_block || !c->x || !c->b || !c->r;
+    c->post = wci_alloc_array(3 * n, sizeof(double));
+    return !c->diag || !c->inv || !c->own_block || !c->x || !c->b || !c->r || !c->post;
 }
 
 /* Adds the level above the top one, unless the top one is small enough or
@@ -299,11 +300,14 @@ int wci_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const i
 /* ------------------------------------------------------------------------ */
 
 /* One loop over a level's nodes or links: its level, the coarser one, and
- * the vectors it reads and writes. */
+ * the vectors it reads and writes. A restriction with `minus` reads in -
+ * factor minus instead of in. */
 typedef struct mg_pass {
     level *fine, *coarse;
     const double *in;
     double *out;
+    const double *minus;
+    double factor;
 } mg_pass;
 
 static int pinned(const level *l, int32_t i) { return l->pin_slot && l->pin_slot[i] >= 0; }
@@ -372,7 +376,7 @@ void wci_multigrid_update(wc_multigrid *mg, const double *mass_diag, const doubl
     level *fine = &mg->level[0];
     fine->mass = mass_diag, fine->block = block, fine->pin_slot = pin_slot;
     for (int32_t k = 0; k + 1 < mg->levels; ++k) {
-        mg_pass p = {&mg->level[k], &mg->level[k + 1], NULL, NULL};
+        mg_pass p = {&mg->level[k], &mg->level[k + 1], NULL, NULL, NULL, 0.0};
         int32_t links = p.coarse->links, nodes = p.coarse->n;
         wci_parallel_for(links, wc_threads_for(links, threads), coarse_links_range, &p);
         wci_parallel_for(nodes, wc_threads_for(nodes, threads), coarse_nodes_range, &p);
@@ -424,25 +428,6 @@ static int sweep_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-static void level_loop(level *l, level *c, wc_range_fn body, const double *in, double *out,
-                       int64_t count, int threads)
-{
-    mg_pass p = {l, c, in, out};
-    wci_parallel_for(count, l->n >= LEVEL_PARALLEL_MIN ? threads : 1, body, &p);
-}
-
-static void residual(level *l, int threads)
-{
-    level_loop(l, NULL, residual_range, NULL, NULL, l->n, threads);
-}
-
-/* One smoothing sweep; the first from x = 0. */
-static void smooth(level *l, int first, int threads)
-{
-    if (!first) residual(l, threads);
-    level_loop(l, NULL, sweep_range, first ? l->b : l->r, NULL, l->n, threads);
-}
-
 /* The coarse right-hand side: each aggregate sums its free members'
  * residuals `in`. */
 static int restrict_range(void *context, int64_t begin, int64_t end)
@@ -455,59 +440,197 @@ static int restrict_range(void *context, int64_t begin, int64_t end)
             int32_t i = f->members[m];
             if (pinned(f, i)) continue;
             const double *r = p->in + 3 * (size_t)i;
-            s[0] += r[0], s[1] += r[1], s[2] += r[2];
+            if (p->minus) {
+                const double *m = p->minus + 3 * (size_t)i;
+                double f = p->factor, v[3] = {r[0] - f * m[0], r[1] - f * m[1], r[2] - f * m[2]};
+                s[0] += v[0], s[1] += v[1], s[2] += v[2];
+            } else {
+                s[0] += r[0], s[1] += r[1], s[2] += r[2];
+            }
         }
         memcpy(p->out + 3 * (size_t)a, s, sizeof s);
     }
     return 0;
 }
 
-/* out += P x_coarse: each free node takes its aggregate's correction. */
+/* out += P in, in the coarse level's solution: each free node takes its
+ * aggregate's correction. */
 static int prolong_range(void *context, int64_t begin, int64_t end)
 {
     const mg_pass *p = context;
-    const level *f = p->fine, *c = p->coarse;
+    const level *f = p->fine;
     for (int64_t i = begin; i < end; ++i) {
         if (pinned(f, (int32_t)i)) continue;
-        const double *xc = c->x + 3 * (size_t)f->agg[i];
+        const double *xc = p->in + 3 * (size_t)f->agg[i];
         double *x = p->out + 3 * (size_t)i;
         x[0] += xc[0], x[1] += xc[1], x[2] += xc[2];
     }
     return 0;
 }
 
-/* l->x = the V-cycle from coarse level k applied to l->b. */
-static void cycle(wc_multigrid *mg, int32_t k, int threads)
+/* Node i's x after the coarse correction, x_i + (P in)_i, as prolong_range
+ * adds it. */
+static void corrected(const level *l, const double *in, int32_t i, double *out)
 {
-    level *l = &mg->level[k];
-    smooth(l, 1, threads);
+    const double *x = l->x + 3 * (size_t)i;
+    out[0] = x[0], out[1] = x[1], out[2] = x[2];
+    if (pinned(l, i)) return;
+    const double *xc = in + 3 * (size_t)l->agg[i];
+    out[0] += xc[0], out[1] += xc[1], out[2] += xc[2];
+}
+
+/* The coarse correction and the sweep after it in one loop, the
+ * correction taken at each node where it is read: post = x' + w D_full^-1
+ * (b - A x'), x' = x + P in. The same arithmetic as prolong_range,
+ * residual_range and sweep_range one after the other, without the two
+ * barriers between them: x' is never stored, and the sweep writes post,
+ * not the x that other nodes' rows read. */
+static int correct_smooth_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    level *l = p->fine;
+    for (int64_t i = begin; i < end; ++i) {
+        double xi[3], xj[3], t[3], ax[3], r[3];
+        corrected(l, p->in, (int32_t)i, xi);
+        wc_sym3_times(l->diag + 6 * (size_t)i, xi[0], xi[1], xi[2], ax);
+        for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k) {
+            corrected(l, p->in, other_end(l, l->adj[k]), xj);
+            wc_sym3_times(l->block + 6 * (size_t)link_of(l->adj[k]), xi[0] - xj[0], xi[1] - xj[1],
+                          xi[2] - xj[2], t);
+            ax[0] += t[0], ax[1] += t[1], ax[2] += t[2];
+        }
+        const double *b = l->b + 3 * (size_t)i;
+        r[0] = b[0] - ax[0], r[1] = b[1] - ax[1], r[2] = b[2] - ax[2];
+        wc_sym3_times(l->inv + 6 * (size_t)i, r[0], r[1], r[2], t);
+        double *x = p->out + 3 * (size_t)i;
+        x[0] = xi[0], x[1] = xi[1], x[2] = xi[2];
+        x[0] += SMOOTHING_WEIGHT * t[0];
+        x[1] += SMOOTHING_WEIGHT * t[1];
+        x[2] += SMOOTHING_WEIGHT * t[2];
+    }
+    return 0;
+}
+
+/* Where level k's cycle leaves its solution: the coarsest level's sweeps
+ * update x in place, a level above it ends in post (correct_smooth_range). */
+static double *cycle_solution(const wc_multigrid *mg, int32_t k)
+{
+    return k + 1 == mg->levels ? mg->level[k].x : mg->level[k].post;
+}
+
+/* The restriction to a level and that level's first sweep, from x = 0,
+ * in one loop: the sweep at aggregate a reads only the b[a] just summed,
+ * so no thread waits between them. */
+static int restrict_sweep_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    mg_pass sweep = {p->coarse, NULL, p->coarse->b, NULL, NULL, 0.0};
+    restrict_range(context, begin, end);
+    return sweep_range(&sweep, begin, end);
+}
+
+/* The cycle's loops run inside the caller's team (parallel.h): a level's
+ * loops split across the team from LEVEL_PARALLEL_MIN nodes up, a smaller
+ * level's run on the team's first thread. */
+static int level_split(const wc_team *team, const level *l)
+{
+    return team->threads > 1 && l->n >= LEVEL_PARALLEL_MIN;
+}
+
+static void team_loop(const wc_team *team, int split, wc_range_fn body, level *l, level *c,
+                      const double *in, double *out, int64_t count)
+{
+    mg_pass p = {l, c, in, out, NULL, 0.0};
+    int64_t begin, end;
+    wc_team_slice(team, count, split, &begin, &end);
+    if (begin < end) body(&p, begin, end);
+}
+
+/* Between a loop and the next one that reads what it wrote at other
+ * nodes, or writes what it read there: a barrier, unless both ran on the
+ * first thread alone. */
+static void sync_loops(const wc_team *team, int split_before, int split_after)
+{
+    if (split_before || split_after) wci_team_barrier(team);
+}
+
+/* One smoothing sweep after the first: the residual, then the sweep from
+ * it. The sweep writes x, which the other nodes' residuals read. */
+static void smooth(level *l, int split, const wc_team *team)
+{
+    team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
+    sync_loops(team, split, split);
+    team_loop(team, split, sweep_range, l, NULL, l->r, NULL, l->n);
+}
+
+/* cycle_solution(k) = the V-cycle from coarse level k applied to the
+ * restriction of `in` (minus `factor` times `minus`, when not NULL), the
+ * finer level's residual (complete on entry).
+ * Every loop of level k splits as level_split(team, level k), the
+ * restriction to it too: a small level's whole cycle then runs on the
+ * first thread without a barrier. The caller waits for the last loop. */
+static void cycle(wc_multigrid *mg, int32_t k, const double *in, const double *minus,
+                  double factor, const wc_team *team)
+{
+    level *f = &mg->level[k - 1], *l = &mg->level[k];
+    int split = level_split(team, l);
+    mg_pass restriction = {f, l, in, l->b, minus, factor};
+    int64_t begin, end;
+    wc_team_slice(team, l->n, split, &begin, &end);
+    if (begin < end) restrict_sweep_range(&restriction, begin, end);
+    sync_loops(team, split, split);
     if (k + 1 == mg->levels) {
-        for (int s = 1; s < COARSEST_SWEEPS; ++s) smooth(l, 0, threads);
+        for (int s = 1; s < COARSEST_SWEEPS; ++s) {
+            if (s > 1) sync_loops(team, split, split);
+            smooth(l, split, team);
+        }
         return;
     }
     level *c = &mg->level[k + 1];
-    residual(l, threads);
-    level_loop(l, c, restrict_range, l->r, c->b, c->n, threads);
-    cycle(mg, k + 1, threads);
-    level_loop(l, c, prolong_range, NULL, l->x, l->n, threads);
-    smooth(l, 0, threads);
+    int split_c = level_split(team, c);
+    team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
+    sync_loops(team, split, split_c);
+    cycle(mg, k + 1, l->r, NULL, 0.0, team);
+    sync_loops(team, split_c, split);
+    team_loop(team, split, correct_smooth_range, l, c, cycle_solution(mg, k + 1), l->post, l->n);
+}
+
+void wci_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
+                                    double alpha, const wc_team *team)
+{
+    cycle(mg, 1, r, q, alpha, team);
+}
+
+typedef struct coarse_solve_pass {
+    wc_multigrid *mg;
+    const double *r;
+} coarse_solve_pass;
+
+static void coarse_solve_body(void *context, const wc_team *team)
+{
+    const coarse_solve_pass *p = context;
+    wci_multigrid_coarse_solve_team(p->mg, p->r, NULL, 0.0, team);
 }
 
 void wci_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads)
 {
-    level *fine = &mg->level[0], *c = &mg->level[1];
-    level_loop(fine, c, restrict_range, r, c->b, c->n, threads);
-    cycle(mg, 1, threads);
+    coarse_solve_pass p = {mg, r};
+    wci_parallel_team(threads, coarse_solve_body, &p);
 }
 
-const double *wci_multigrid_coarse_solution(const wc_multigrid *mg) { return mg->level[1].x; }
+const double *wci_multigrid_coarse_solution(const wc_multigrid *mg)
+{
+    return cycle_solution(mg, 1);
+}
 
 const int32_t *wci_multigrid_fine_aggregates(const wc_multigrid *mg) { return mg->level[0].agg; }
 
 void wci_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, int threads)
 {
     wci_multigrid_coarse_solve(mg, r, threads);
-    level_loop(&mg->level[0], &mg->level[1], prolong_range, NULL, z, mg->level[0].n, threads);
+    mg_pass p = {&mg->level[0], &mg->level[1], cycle_solution(mg, 1), z, NULL, 0.0};
+    wci_parallel_for(mg->level[0].n, mg->level[0].n >= LEVEL_PARALLEL_MIN ? threads : 1,
+                    prolong_range, &p);
 }
 
 int32_t wci_multigrid_level_size(const wc_multigrid *mg, int32_t k) { return mg->level[k].n; }
@@ -524,6 +647,7 @@ void wci_multigrid_level_product(wc_multigrid *mg, int32_t k, const double *in, 
     size_t len = 3 * (size_t)l->n;
     memcpy(l->x, in, len * sizeof *in);
     memset(l->b, 0, len * sizeof *l->b);
-    residual(l, 1);
+    mg_pass p = {l, NULL, NULL, NULL, NULL, 0.0};
+    residual_range(&p, 0, l->n);
     for (size_t k = 0; k < len; ++k) out[k] = -l->r[k];
 }

@@ -36,6 +36,8 @@
 
 #include <stdint.h>
 
+#include "parallel.h"
+
 /// Cloths with fewer particles get no coarse levels: below about this size
 /// the coarse levels cost more per iteration than they save in iterations
 /// (measured on the thesis drape at 12 steps per frame: 7 % slower at 2,500
@@ -77,6 +79,14 @@ void wci_multigrid_add_correction(wc_multigrid *mg, const double *r, double *z, 
 /// level, valid until the next call; a free fine node i adds entry
 /// aggregates[i] of it (P), a pinned node nothing.
 void wci_multigrid_coarse_solve(wc_multigrid *mg, const double *r, int threads);
+/// The same on a team already running (wci_parallel_team), every thread
+/// calling it, for the residual r - alpha q (q NULL: r), computed where it
+/// is read as (r - alpha * q) is: r and q must be complete on entry (a
+/// barrier after the loops that wrote them), and the solution is complete
+/// after the caller's next wci_team_barrier. So a caller can update r out
+/// of place in the same phase.
+void wci_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
+                                    double alpha, const wc_team *team);
 const double *wci_multigrid_coarse_solution(const wc_multigrid *mg);
 const int32_t *wci_multigrid_fine_aggregates(const wc_multigrid *mg);
 

@@ -33,3 +33,32 @@ int wci_parallel_for(int64_t n, int threads, wc_range_fn body, void *context)
 #endif
     return body(context, 0, n) != 0;
 }
+
+void wci_parallel_team(int threads, wc_team_fn body, void *context)
+{
+#ifdef _OPENMP
+    if (threads > 1) {
+#pragma omp parallel num_threads(threads)
+        {
+            wc_team team = {omp_get_thread_num(), omp_get_num_threads()};
+            body(context, &team);
+        }
+        return;
+    }
+#else
+    (void)threads;
+#endif
+    wc_team team = {0, 1};
+    body(context, &team);
+}
+
+void wci_team_barrier(const wc_team *team)
+{
+#ifdef _OPENMP
+    if (team->threads > 1) {
+#pragma omp barrier
+    }
+#else
+    (void)team;
+#endif
+}

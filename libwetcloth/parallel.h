@@ -33,4 +33,40 @@ typedef int (*wc_range_fn)(void *context, int64_t begin, int64_t end);
 /// of a 400-particle cloth cost, and a step runs several of them.
 int wci_parallel_for(int64_t n, int threads, wc_range_fn body, void *context);
 
+/// One thread of a team that runs a whole sequence of loops in one parallel
+/// region (wci_parallel_team): its number, from 0, and the team's size.
+typedef struct wc_team {
+    int thread, threads;
+} wc_team;
+
+typedef void (*wc_team_fn)(void *context, const wc_team *team);
+
+/// Runs body once on each thread of a team of `threads`: with threads > 1
+/// inside one parallel region, with one by a plain call (team {0, 1}).
+/// Why: a solver iteration runs a dozen dependent loops, and a region per
+/// loop pays the team's wake-up and a join for each; a thread the scheduler
+/// takes away holds every one of them. In one region the loops are
+/// separated by barriers (wci_team_barrier), only where a loop reads what
+/// another thread wrote.
+void wci_parallel_team(int threads, wc_team_fn body, void *context);
+
+/// Waits until every thread of the team has reached it; nothing for a
+/// team of one.
+void wci_team_barrier(const wc_team *team);
+
+/// This thread's part [*begin, *end) of the items [0, n): with `split`, the
+/// contiguous slice wci_parallel_for would give it; without, all of them on
+/// the team's first thread and none on the others.
+static inline void wc_team_slice(const wc_team *team, int64_t n, int split, int64_t *begin,
+                                 int64_t *end)
+{
+    if (split) {
+        *begin = n * team->thread / team->threads;
+        *end = n * (team->thread + 1) / team->threads;
+    } else {
+        *begin = 0;
+        *end = team->thread == 0 ? n : 0;
+    }
+}
+
 #endif
