@@ -14,6 +14,7 @@
 
 #include "checker.h"
 #include "convex.h"
+#include "predicates.h"
 #include "test_util.h"
 #include "wetcloth.h"
 
@@ -516,8 +517,52 @@ static void test_speed(void)
     }
 }
 
+/* Points a = (0.5 + i u, 0.5 + j u), u = 2^-53, against the line through
+ * b = (12, 12) and c = (24, 24): det[b - a, c - a] = 12 (a_y - a_x) =
+ * 12 (j - i) u exactly, so the sign is that of j - i. In floating point the
+ * determinant is mostly rounding error here (Shewchuk's example), so this
+ * tests the exact path. orient3d gets the same points in the plane z = 0
+ * and d = (0, 0, 1): the same sign. */
+static void test_exact_orientation(void)
+{
+    const double u = 1.1102230246251565e-16;
+    int wrong2 = 0, wrong3 = 0;
+    for (int i = 0; i < 64; ++i)
+        for (int j = 0; j < 64; ++j) {
+            double a2[2] = {0.5 + i * u, 0.5 + j * u}, b2[2] = {12, 12}, c2[2] = {24, 24};
+            double a3[3] = {a2[0], a2[1], 0}, b3[3] = {12, 12, 0}, c3[3] = {24, 24, 0},
+                   d3[3] = {0, 0, 1};
+            int expect = (j > i) - (j < i);
+            wrong2 += wci_orient2d(a2, b2, c2) != expect;
+            wrong3 += wci_orient3d(a3, b3, c3, d3) != expect;
+        }
+    /* Long differences: b - a = d has about 50 significant bits (a multiple
+     * of 2^-52 in [1/4, 1/2)), c = a + 2 d exactly, moved by s ulps in y:
+     * det = d_x s 2^-52, sign s, as small as the rounding error of the
+     * floating-point determinant, so many of these go the exact way. */
+    uint64_t seed = 12345;
+    for (int k = 0; k < 3000; ++k) {
+        double dx, dy;
+        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+        dx = 0x1p-2 * (1.0 + (double)(seed >> 11) * 0x1p-53);
+        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+        dy = 0x1p-2 * (1.0 + (double)(seed >> 11) * 0x1p-53);
+        int sgn = k % 3 - 1;
+        double a2[2] = {1.0, 1.0}, b2[2] = {1.0 + dx, 1.0 + dy};
+        double c2[2] = {1.0 + 2.0 * (b2[0] - 1.0), 1.0 + 2.0 * (b2[1] - 1.0) + sgn * 0x1p-52};
+        double a3[3] = {a2[0], a2[1], 0}, b3[3] = {b2[0], b2[1], 0}, c3[3] = {c2[0], c2[1], 0},
+               d3[3] = {0, 0, 1};
+        wrong2 += wci_orient2d(a2, b2, c2) != sgn;
+        wrong3 += wci_orient3d(a3, b3, c3, d3) != sgn;
+    }
+    printf("exact orientation, 4096 near-collinear points and 3000 with long differences: "
+           "orient2d %d wrong, orient3d %d wrong\n", wrong2, wrong3);
+    CHECK(wrong2 == 0 && wrong3 == 0, "orientation signs wrong: %d (2D), %d (3D)", wrong2, wrong3);
+}
+
 int main(void)
 {
+    test_exact_orientation();
     test_triangle_pairs();
     test_random_pairs();
     test_flat_and_folded();
