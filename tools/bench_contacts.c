@@ -30,7 +30,10 @@
  * out (file: float64 positions of every frame, for error measurement),
  * adhesion, spread, wet_friction, damping (stretch damping; the cloth
  * material's, for experiments),
- * check (1: count intersections at the last frame; 2: at every frame).
+ * check (1: count intersections at the last frame; 2: at every frame),
+ * bend (1: the cylinder's ends rise; 0: it stays straight), trace (1: one
+ * line per frame on stderr: wall and collide ms, longest link, fail-safe
+ * particles, intersections when counted).
  *
  * Printed: ms per frame (wall), collision ms per frame (the library's
  * collide phase), substeps per frame, intersections (all, and cloth against
@@ -53,7 +56,7 @@
 
 typedef struct options {
     const char *scene;
-    int frames, steps, threads, wet, self, size, check, steps_given;
+    int frames, steps, threads, wet, self, size, check, steps_given, bend, trace;
     const char *integrator;
     double thickness, friction, adhesion, spread, wet_friction, damping;
     const char *out;
@@ -161,7 +164,7 @@ static int parse(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->scene = "thesis", o->frames = 24, o->threads = 1, o->thickness = 0.02, o->friction = 0.5;
-    o->integrator = "default", o->check = 1, o->adhesion = -1.0, o->spread = -1.0, o->wet_friction = -1.0, o->damping = -1.0;
+    o->integrator = "default", o->check = 1, o->bend = 1, o->adhesion = -1.0, o->spread = -1.0, o->wet_friction = -1.0, o->damping = -1.0;
     for (int k = 1; k < argc; ++k) {
         char *eq = strchr(argv[k], '=');
         if (!eq) return 0;
@@ -175,6 +178,8 @@ static int parse(int argc, char **argv, options *o)
         else if (!strcmp(key, "self")) o->self = atoi(val);
         else if (!strcmp(key, "size")) o->size = atoi(val);
         else if (!strcmp(key, "check")) o->check = atoi(val);
+        else if (!strcmp(key, "bend")) o->bend = atoi(val);
+        else if (!strcmp(key, "trace")) o->trace = atoi(val);
         else if (!strcmp(key, "integrator")) o->integrator = val;
         else if (!strcmp(key, "thickness")) o->thickness = atof(val);
         else if (!strcmp(key, "friction")) o->friction = atof(val);
@@ -231,7 +236,7 @@ static scene make_scene(const options *o)
     } else if (!strcmp(o->scene, "soaked")) {
         s.collider_mesh = uv_sphere(176, 88, 0.5), n = 50, width = 2.0, height = 1.0;
     } else if (!strcmp(o->scene, "cylinder")) {
-        s.collider_mesh = tube(96, 154, 0.15, 1.2), n = 33, height = 0.35, s.deforming = 1;
+        s.collider_mesh = tube(96, 154, 0.15, 1.2), n = 33, height = 0.35, s.deforming = o->bend;
     } else {
         fprintf(stderr, "unknown scene %s\n", o->scene);
         exit(2);
@@ -305,7 +310,8 @@ int main(int argc, char **argv)
         }
         double t0 = bench_now();
         wc_status st = wc_world_advance(s.world, 1.0 / 24.0, steps);
-        wall += bench_now() - t0;
+        double frame_seconds = bench_now() - t0;
+        wall += frame_seconds;
         if (st != WC_OK) {
             finite = 0;
             fprintf(stderr, "frame %d: %s\n", f, wc_world_last_error(s.world));
@@ -331,6 +337,12 @@ int main(int argc, char **argv)
             last_collider = k.cloth_collider;
             if (last_intersections > worst_intersections) worst_intersections = last_intersections;
         }
+        if (o.trace)
+            fprintf(stderr, "frame %d: %.1f ms (collide %.1f), longest link %.3f, fail-safe %lld, "
+                            "intersections %d\n",
+                    f, 1e3 * frame_seconds, 1e3 * stats.collide_seconds,
+                    longest_link(xyz, pairs, rest, links), (long long)stats.failsafe_particles,
+                    o.check == 2 ? last_intersections : -1);
     }
     if (out) fclose(out);
     int frames_done = o.frames;
