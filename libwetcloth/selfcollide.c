@@ -1,4 +1,4 @@
-/* Self-collision of one cloth over one step (SPEC 2), after Bridson, Fedkiw
+/* Self-collision of one cloth over one step (docs/model.md, Collisions), after Bridson, Fedkiw
  * & Anderson 2002, "Robust treatment of collisions, contact and friction for
  * cloth animation", with the normal-cone culling of Volino & Magnenat-
  * Thalmann 1994 ("Efficient self-collision detection on smoothly
@@ -7,8 +7,8 @@
  * What is tested: vertex-face pairs (vertex not a corner of the face) for
  * proximity at the end of the step and for collision during it (the
  * coplanarity cubic); edge-edge pairs (no shared vertex) for collision
- * during the step. Edges get no proximity repulsion: SPEC asks particles to
- * keep the thickness, which vertex-face proximity does, and edge pairs within
+ * during the step. Edges get no proximity repulsion: the model asks particles
+ * to keep the thickness, which vertex-face proximity does, and edge pairs within
  * h of each other are several times more numerous than vertex-face ones in
  * stacked layers; crossing edges are still stopped by the continuous test.
  *
