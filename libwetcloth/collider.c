@@ -47,8 +47,6 @@ void wci_collider_destroy(wc_collider *c)
     wci_free(c->next);
     wci_free(c->boxes);
     wci_free(c->normals);
-    wci_free(c->vertex_start);
-    wci_free(c->vertex_triangles);
     wci_bvh_destroy(&c->bvh);
     wci_convex_shape_destroy(&c->convex);
     wci_free(c);
@@ -158,23 +156,6 @@ static wc_status validate_mesh(const wc_mesh_collider_def *d, wc_message *msg)
     return check_surface(msg, "mesh_collider_def", d->thickness, d->friction);
 }
 
-/* The triangles of each vertex, ascending (CSR in vertex_start and
- * vertex_triangles, allocated by the caller). */
-static void list_vertex_triangles(wc_collider *c)
-{
-    int32_t nv = c->vertex_count, nt = c->triangle_count;
-    memset(c->vertex_start, 0, ((size_t)nv + 1) * sizeof *c->vertex_start);
-    for (size_t k = 0; k < 3 * (size_t)nt; ++k) c->vertex_start[c->triangles[k] + 1]++;
-    for (int32_t v = 0; v < nv; ++v) c->vertex_start[v + 1] += c->vertex_start[v];
-    for (int32_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            int32_t v = c->triangles[3 * (size_t)t + k];
-            c->vertex_triangles[c->vertex_start[v]++] = t; /* undone below */
-        }
-    for (int32_t v = nv; v > 0; --v) c->vertex_start[v] = c->vertex_start[v - 1];
-    c->vertex_start[0] = 0;
-}
-
 wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d, int32_t *out)
 {
     if (!w) return WC_ERROR_INVALID_ARGUMENT;
@@ -198,16 +179,12 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
         c->next = wci_alloc_array(nv, sizeof *c->next);
         c->boxes = wci_alloc_array(6 * nt, sizeof *c->boxes);
         c->normals = wci_alloc_array(3 * nt, sizeof *c->normals);
-        c->vertex_start = wci_alloc_array((size_t)d->vertex_count + 1, sizeof *c->vertex_start);
-        c->vertex_triangles = wci_alloc_array(3 * nt, sizeof *c->vertex_triangles);
     }
-    if (!c || !c->triangles || !c->current || !c->target || !c->next || !c->boxes || !c->normals ||
-        !c->vertex_start || !c->vertex_triangles) {
+    if (!c || !c->triangles || !c->current || !c->target || !c->next || !c->boxes || !c->normals) {
         wci_collider_destroy(c);
         return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
     }
     memcpy(c->triangles, d->triangles, 3 * nt * sizeof *c->triangles);
-    list_vertex_triangles(c);
     if (!build_edges(c)) {
         wci_collider_destroy(c);
         return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");

@@ -72,11 +72,6 @@ typedef struct wc_collider {
     /// them (narrowphase.c).
     double *normals;
     int normals_current;
-    /// Per vertex, the triangles it is a corner of (CSR: those of vertex v
-    /// are vertex_triangles[vertex_start[v] .. vertex_start[v + 1]]): the
-    /// vertex's normal, for the cloth triangles too thin to have one
-    /// (narrowphase.c).
-    int32_t *vertex_start, *vertex_triangles;
     /// The collider's path: summed over the committed steps, the largest
     /// displacement of any of its vertices in each; and that displacement
     /// in the step being computed. No vertex has moved farther than the

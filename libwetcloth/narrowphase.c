@@ -247,45 +247,6 @@ static int element_contact(const int32_t *idx, const double *w, int count, const
     return 1;
 }
 
-/* A triangle whose smallest height is under SLIVER of its longest edge is
- * too thin for its normal to tell the side the cloth is on: the normal
- * swings by about the corners' relative motion over that height, and a
- * crumpled cloth's triangle (two neighbours 0.3 mm apart at a rest length
- * of 31 mm, on the bending dense tube at 12 implicit steps per frame)
- * turned it 150 degrees within a step, so that the push took the cloth
- * 4-5 cm into the tube, over and over, and tore it (links at 20x their rest
- * length). For such a triangle the collider's normal at the vertex (its
- * faces' area-weighted sum), which cannot swing so, reads the side. */
-#define SLIVER 0.05
-
-static int sliver(const double a[3], const double b[3], const double c[3])
-{
-    double ab[3], ac[3], bc[3], m[3];
-    for (int d = 0; d < 3; ++d) ab[d] = b[d] - a[d], ac[d] = c[d] - a[d], bc[d] = c[d] - b[d];
-    cross3(ab, ac, m);
-    double longest2 = dot3(ab, ab);
-    if (dot3(ac, ac) > longest2) longest2 = dot3(ac, ac);
-    if (dot3(bc, bc) > longest2) longest2 = dot3(bc, bc);
-    /* height = |m| / longest; compared squared: |m|^2 < SLIVER^2 longest^4 */
-    return dot3(m, m) < SLIVER * SLIVER * longest2 * longest2;
-}
-
-/* Unit normal of collider vertex v with the vertices at xyz: the sum of
- * its triangles' cross products (area-weighted); 0 where they cancel. */
-static int vertex_normal(const wc_collider *c, const double *xyz, int32_t v, double out[3])
-{
-    out[0] = out[1] = out[2] = 0.0;
-    for (int32_t j = c->vertex_start[v]; j < c->vertex_start[v + 1]; ++j) {
-        const int32_t *t = c->triangles + 3 * (size_t)c->vertex_triangles[j];
-        double a[3], b[3], d[3], e[3], m[3];
-        vertex_of(xyz, t[0], a), vertex_of(xyz, t[1], b), vertex_of(xyz, t[2], d);
-        for (int k = 0; k < 3; ++k) e[k] = d[k] - a[k], b[k] -= a[k];
-        cross3(b, e, m);
-        for (int k = 0; k < 3; ++k) out[k] += m[k];
-    }
-    return normalize3(out);
-}
-
 int wci_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t idx[3], const wc_collider *col,
                               int32_t vertex, int ccd, double r, double *d2, wc_contact *out)
 {
@@ -303,16 +264,8 @@ int wci_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t idx[3]
         ab0[d] = b0[d] - a0[d], ac0[d] = c0[d] - a0[d];
         ab1[d] = b1[d] - a1[d], ac1[d] = c1[d] - a1[d];
     }
-    int thin = sliver(a0, b0, c0) || sliver(a1, b1, c1);
-    if (thin) {
-        /* the collider's own normal at the vertex stands in for the
-         * triangle's; none there (a vertex where the faces cancel): the
-         * edges decide */
-        if (!vertex_normal(col, col->current, vertex, n0) || !vertex_normal(col, col->next, vertex, n1))
-            return 0;
-    } else if (!turning_cross(ab0, ab1, ac0, ac1, n0, n1)) {
-        return 0; /* crushed flat at either end: the edges decide */
-    }
+    /* crushed flat at either end: the edges decide */
+    if (!turning_cross(ab0, ab1, ac0, ac1, n0, n1)) return 0;
     bary_point(a1, b1, c1, w, p1);
     bary_point(a0, b0, c0, w, p0);
     /* The cloth belongs on the side of the vertex it was on at the start. */
@@ -322,10 +275,9 @@ int wci_narrow_vertex_triangle(const wc_particle_arrays *p, const int32_t idx[3]
     if (side == 0.0) side = dot3(end_gap, n1);
     side = side < 0.0 ? -1.0 : 1.0;
     for (int d = 0; d < 3; ++d) n[d] = side * n1[d];
-    /* Off the face region, or anywhere on a triangle too thin to have a
-     * face, on the right side: push along the offset. */
+    /* Off the face region, on the right side: push along the offset. */
     double along = dot3(end_gap, n), len = sqrt(dot3(end_gap, end_gap));
-    if (along > 0.0 && len > 0.0 && (thin || w[0] == 0.0 || w[1] == 0.0 || w[2] == 0.0))
+    if (along > 0.0 && len > 0.0 && (w[0] == 0.0 || w[1] == 0.0 || w[2] == 0.0))
         for (int d = 0; d < 3; ++d) n[d] = end_gap[d] / len;
     for (int d = 0; d < 3; ++d) motion[d] = v1[d] - v0[d];
     return element_contact(idx, w, 3, n, dot3(end_gap, n), motion, r, out);
