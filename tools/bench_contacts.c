@@ -277,7 +277,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: bench_contacts scene=thesis|sphere64|sphere176|soaked|cylinder|"
                         "drape101 [frames=24] [integrator=default|verlet|xpbd|implicit] [steps=0] "
                         "[threads=1] [wet=0] [self=0] [thickness=0.02] [friction=0.5] [size=N] "
-                        "[check=1] [out=FILE]\n");
+                        "[check=1] [bend=1] [trace=0] [out=FILE]\n");
         return 2;
     }
     scene s = make_scene(&o);
@@ -329,7 +329,8 @@ int main(int argc, char **argv)
         if (landed < 0 && any) landed = f;
         if (landed >= 0)
             for (int32_t i = 0; i < n; ++i) highest = fmax(highest, xyz[3 * (size_t)i + 2]);
-        stretch = fmax(stretch, longest_link(xyz, pairs, rest, links));
+        double longest = longest_link(xyz, pairs, rest, links);
+        stretch = fmax(stretch, longest);
         if (o.check == 2 || (o.check == 1 && f == o.frames - 1)) {
             wc_intersection_counts k;
             bench_check(wc_world_count_intersections(s.world, &k), s.world, "intersections");
@@ -341,7 +342,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "frame %d: %.1f ms (collide %.1f), longest link %.3f, fail-safe %lld, "
                             "intersections %d\n",
                     f, 1e3 * frame_seconds, 1e3 * stats.collide_seconds,
-                    longest_link(xyz, pairs, rest, links), (long long)stats.failsafe_particles,
+                    longest, (long long)stats.failsafe_particles,
                     o.check == 2 ? last_intersections : -1);
     }
     if (out) fclose(out);
