@@ -18,9 +18,12 @@
  *     of their particles' boxes and a cone that holds every triangle normal
  *     of the patch over the whole step. A connected piece of surface whose
  *     normals all stay within 90 degrees of one direction is a height field
- *     over the plane across it and cannot pass through itself (the contour
- *     condition of Volino & Magnenat-Thalmann is not checked: a compact
- *     patch cannot wind around itself without tearing); within 60 degrees
+ *     over the plane across it and cannot pass through itself, as long as
+ *     its projection onto that plane is one-to-one (the contour condition of
+ *     Volino & Magnenat-Thalmann, not checked: an uncompressed compact patch
+ *     cannot wind around itself without tearing, but a crushed free edge can
+ *     fold over itself in the plane with every triangle still facing the
+ *     same way; docs/model.md, Known gaps); within 60 degrees
  *     it cannot even bring two points closer than half their distance along
  *     the surface (see REST_EXCLUSION). So a patch with a narrow cone, and
  *     two patches sharing a vertex, or both sharing one with a third, whose
