@@ -23,6 +23,9 @@ struct wc_cloth_group {
     /// last step resolved here.
     int32_t world_cloths;
     uint8_t *handled;
+    /// Per combined particle: moved again by the collider stage after the
+    /// combined pass (wci_cloth_group_flags, wci_cloth_group_verify).
+    uint8_t *again;
     /// The combined cloth: only what collision reads (see selfcollide.c).
     /// Its per-particle arrays are views of the world's, whose members are
     /// one range (particles.h), set before each pass; it owns its
@@ -55,7 +58,8 @@ void wci_cloth_group_destroy(wc_cloth_group *g)
     wci_free(c->adhesive_data);
     wci_self_state_destroy(c->self);
     void *blocks[] = {g->member, g->first, g->first_triangle, g->self, g->friction,
-                      g->wet_friction, g->handled, g->saved_pairs, g->saved_data, g->pieces};
+                      g->wet_friction, g->handled, g->saved_pairs, g->saved_data, g->pieces,
+                      g->again};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wci_free(blocks[k]);
     wci_free(g);
 }
@@ -90,6 +94,7 @@ static int allocate(wc_cloth_group *g, wc_cloth *const *cloths, int32_t cloth_co
     wc_cloth *comb = &g->combined;
     comb->particle_count = g->first[m];
     comb->topology.triangle_count = g->first_triangle[m];
+    if (!(g->again = wci_alloc_array((size_t)g->first[m] + 1, 1))) return 0;
     comb->topology.triangles =
         wci_alloc_array(3 * (size_t)g->first_triangle[m], sizeof *comb->topology.triangles);
     return comb->topology.triangles != NULL;
@@ -333,4 +338,39 @@ wc_status wci_cloth_group_collide(wc_cloth_group *g, wc_cloth *const *cloths, do
 int wci_cloth_group_handled(const wc_cloth_group *g, int32_t cloth)
 {
     return g && cloth < g->world_cloths && g->handled[cloth];
+}
+
+uint8_t *wci_cloth_group_flags(wc_cloth_group *g, int32_t cloth)
+{
+    if (!wci_cloth_group_handled(g, cloth)) return NULL;
+    for (int32_t k = 0; k < g->count; ++k)
+        if (g->member[k] == cloth) return g->again + g->first[k];
+    return NULL;
+}
+
+wc_status wci_cloth_group_verify(wc_cloth_group *g, wc_cloth *const *cloths, int threads,
+                                 wc_step_stats *stats)
+{
+    int any = 0;
+    for (int32_t i = 0; i < g->combined.particle_count && !any; ++i) any = g->again[i];
+    if (!any) return WC_OK;
+    view_members(g, cloths, 1);
+    wc_status s = wci_self_verify(&g->combined, g->again, threads, stats);
+    view_members(g, cloths, 0);
+    memset(g->again, 0, (size_t)g->combined.particle_count);
+    return s;
+}
+
+const uint8_t *wci_cloth_group_moved(const wc_cloth_group *g, int32_t cloth, int32_t *any)
+{
+    *any = 0;
+    if (!wci_cloth_group_handled(g, cloth)) return NULL;
+    int32_t total;
+    const uint8_t *moved = wci_self_state_moved(g->combined.self, &total);
+    for (int32_t k = 0; k < g->count; ++k)
+        if (g->member[k] == cloth) {
+            *any = total > 0;
+            return moved + g->first[k];
+        }
+    return NULL;
 }

@@ -60,6 +60,23 @@ void wci_cloth_group_adhesion(wc_cloth_group *group, wc_cloth *const *cloths);
 /// index): then its own self-collision must not run in that step.
 int wci_cloth_group_handled(const wc_cloth_group *group, int32_t cloth);
 
+/// For a cloth the last wci_cloth_group_collide handled: its particles'
+/// flags of having been moved there (one each), with *any set when the group
+/// moved any particle; NULL (and *any 0) for a cloth it did not handle.
+const uint8_t *wci_cloth_group_moved(const wc_cloth_group *group, int32_t cloth, int32_t *any);
+
+/// For a cloth the last wci_cloth_group_collide handled: where to mark (one
+/// flag per particle, zero until marked) the particles the collider stage
+/// moved again after it; NULL for a cloth it did not handle.
+uint8_t *wci_cloth_group_flags(wc_cloth_group *group, int32_t cloth);
+
+/// After the collider stage moved marked particles of handled members again:
+/// detects the combined motion's colliding pairs among them and puts them
+/// back (wci_self_verify), then clears the marks. WC_ERROR_OUT_OF_MEMORY on
+/// out-of-memory.
+wc_status wci_cloth_group_verify(wc_cloth_group *group, wc_cloth *const *cloths, int threads,
+                                 wc_step_stats *stats);
+
 /// Whether the cloths can collide with each other at all: two or more with
 /// collide_cloths set.
 int wci_cloth_group_possible(wc_cloth *const *cloths, int32_t cloth_count);

@@ -38,6 +38,9 @@ struct wc_collider_contacts {
     /// Between rounds: recheck (the particle pass must test the particle
     /// again) and shifted (the feature pass must visit its elements).
     uint8_t *recheck, *shifted;
+    /// Moved since the start of the last recheck (see
+    /// wci_collider_contacts_recheck).
+    uint8_t *changed;
     /// Per particle: surface motion of the last face the particle pass
     /// answered for it, and of the collider feature that last pushed it
     /// (the fail-safes carry the particle along by them).
@@ -83,6 +86,7 @@ static void track(wc_collider_contacts *s, const wc_particle_arrays *p, int32_t 
     last[0] = p->nx[i], last[1] = p->ny[i], last[2] = p->nz[i];
     double u[3] = {p->nx[i] - p->x[i], p->ny[i] - p->y[i], p->nz[i] - p->z[i]};
     s->motion[i] = sqrt(dot3(u, u));
+    s->changed[i] = 1;
 }
 
 /* At the start of the stage: each path goes on to the start of the step
@@ -187,6 +191,7 @@ wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *c)
     size_t most = (size_t)(s->el.triangle_count > s->el.edge_count ? s->el.triangle_count
                                                                    : s->el.edge_count) + 1;
     s->recheck = wci_alloc_array(n, 1);
+    s->changed = wci_alloc_array(n, 1);
     s->shifted = wci_alloc_array(n, 1);
     s->carry = wci_alloc_array(3 * n, sizeof *s->carry);
     s->moved = wci_alloc_array(n, 1);
@@ -201,7 +206,7 @@ wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *c)
     s->path_start = wci_alloc_array(n, sizeof *s->path_start);
     s->last_end = wci_alloc_array(3 * n, sizeof *s->last_end);
     s->motion = wci_alloc_array(n, sizeof *s->motion);
-    if (!ok || !s->path || !s->path_start || !s->last_end || !s->motion || !s->recheck || !s->shifted || !s->carry || !s->moved || !s->moving ||
+    if (!ok || !s->path || !s->path_start || !s->last_end || !s->motion || !s->recheck || !s->changed || !s->shifted || !s->carry || !s->moved || !s->moving ||
         !s->moved_list || !s->moving_list || !s->rebase_list || !s->rebase_flag ||
         !s->visit_mark || !s->visit_list) {
         wci_collider_contacts_destroy(s);
@@ -215,7 +220,7 @@ void wci_collider_contacts_destroy(wc_collider_contacts *s)
     if (!s) return;
     for (int32_t k = 0; k < s->cand_count; ++k) wci_candidates_destroy(&s->cand[k]);
     void *blocks[] = {s->cand, s->el.edges, s->el.triangles_start, s->el.triangles_of,
-                      s->el.edges_start, s->el.edges_of, s->recheck, s->shifted, s->carry,
+                      s->el.edges_start, s->el.edges_of, s->recheck, s->changed, s->shifted, s->carry,
                       s->moved, s->moving, s->moved_list, s->moving_list, s->rebase_list,
                       s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->tested, s->measured,
                       s->path, s->path_start, s->last_end, s->motion};
@@ -760,6 +765,37 @@ static int feature_pass(wc_collider_contacts *s, wc_cloth *c, const wc_particle_
 /* The stage                                                                */
 /* ------------------------------------------------------------------------ */
 
+/* Particle and feature passes in turn until the feature pass moves nothing
+ * (ROUNDS at most). The first particle pass takes every particle (all) or
+ * those marked for recheck; `also` (or NULL) adds particles to the first
+ * feature pass's moved set, as if the particle pass had moved them. */
+static wc_status pass_rounds(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
+                             wc_collider *const *colliders, int32_t count, int32_t steps_left,
+                             int threads, int all, const uint8_t *also, int32_t *failsafe)
+{
+    memset(s->shifted, 0, (size_t)c->particle_count);
+    for (int round = 0; round < ROUNDS; ++round) {
+        *failsafe += particle_pass(s, c, p, colliders, count, threads, all && round == 0);
+        if (also && round == 0)
+            for (int32_t i = 0; i < c->particle_count; ++i) s->shifted[i] |= also[i];
+        /* particles that left their cover during the pass are rebased for
+         * the feature pass and the next step */
+        for (int32_t k = 0; k < count; ++k) {
+            if (!colliders[k]->is_mesh) continue;
+            double path = colliders[k]->path + colliders[k]->step_motion;
+            for (int32_t i = 0; i < c->particle_count; ++i)
+                if (s->shifted[i] &&
+                    !wc_candidates_covers(&s->cand[k], i, wci_candidates_displacement(&s->cand[k], p, i), path))
+                    note_rebase(s, i);
+            if (flush_rebase(s, colliders[k], k, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+        }
+        int moved = feature_pass(s, c, p, colliders, count, all && round == 0, steps_left, failsafe);
+        if (moved < 0) return WC_ERROR_OUT_OF_MEMORY;
+        if (!moved) break;
+    }
+    return WC_OK;
+}
+
 wc_status wci_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
                                        wc_collider *const *colliders, int32_t count,
                                        int32_t steps_left, int threads, wc_step_stats *stats)
@@ -768,25 +804,29 @@ wc_status wci_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
     wc_particle_arrays p = wci_particle_arrays_of(c);
     begin_paths(s, &p);
     if (refresh_candidates(s, c, colliders, count, &p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
-    memset(s->shifted, 0, (size_t)c->particle_count);
     int32_t failsafe = 0;
-    for (int round = 0; round < ROUNDS; ++round) {
-        failsafe += particle_pass(s, c, &p, colliders, count, threads, round == 0);
-        /* particles that left their cover during the pass are rebased for
-         * the feature pass and the next step */
-        for (int32_t k = 0; k < count; ++k) {
-            if (!colliders[k]->is_mesh) continue;
-            double path = colliders[k]->path + colliders[k]->step_motion;
-            for (int32_t i = 0; i < c->particle_count; ++i)
-                if (s->shifted[i] &&
-                    !wc_candidates_covers(&s->cand[k], i, wci_candidates_displacement(&s->cand[k], &p, i), path))
-                    note_rebase(s, i);
-            if (flush_rebase(s, colliders[k], k, &p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
-        }
-        int moved = feature_pass(s, c, &p, colliders, count, round == 0, steps_left, &failsafe);
-        if (moved < 0) return WC_ERROR_OUT_OF_MEMORY;
-        if (!moved) break;
-    }
+    wc_status status = pass_rounds(s, c, &p, colliders, count, steps_left, threads, 1, NULL, &failsafe);
     stats->failsafe_particles += failsafe;
-    return WC_OK;
+    return status;
+}
+
+wc_status wci_collider_contacts_recheck(wc_cloth *c, wc_collider_contacts *s,
+                                       wc_collider *const *colliders, int32_t count,
+                                       const uint8_t *moved, int32_t steps_left, int threads,
+                                       wc_step_stats *stats, const uint8_t **changed)
+{
+    *changed = NULL;
+    if (count <= 0) return WC_OK;
+    wc_particle_arrays p = wci_particle_arrays_of(c);
+    int any = 0;
+    for (int32_t i = 0; i < c->particle_count; ++i)
+        if (moved[i]) track(s, &p, i), s->recheck[i] = 1, any = 1;
+    if (!any) return WC_OK;
+    memset(s->changed, 0, (size_t)c->particle_count);
+    int32_t failsafe = 0;
+    wc_status status = pass_rounds(s, c, &p, colliders, count, steps_left, threads, 0, moved, &failsafe);
+    stats->failsafe_particles += failsafe;
+    for (int32_t i = 0; i < c->particle_count && !*changed; ++i)
+        if (s->changed[i]) *changed = s->changed;
+    return status;
 }

@@ -48,6 +48,17 @@ wc_status wci_collider_contacts_resolve(wc_cloth *cloth, wc_collider_contacts *s
                                        wc_collider *const *colliders, int32_t collider_count,
                                        int32_t steps_left, int threads, wc_step_stats *stats);
 
+/// The stage again for the particles marked in moved (moved since resolve,
+/// by self-collision or collision between cloths): what they touch now is
+/// pushed out as in resolve, so no later pass leaves a cloth through a
+/// collider. *changed gets one flag per particle for those this moved, or
+/// NULL if it moved none (the flags are the state's, valid until its next
+/// call). Otherwise the same contract as resolve.
+wc_status wci_collider_contacts_recheck(wc_cloth *cloth, wc_collider_contacts *state,
+                                       wc_collider *const *colliders, int32_t collider_count,
+                                       const uint8_t *moved, int32_t steps_left, int threads,
+                                       wc_step_stats *stats, const uint8_t **changed);
+
 /// Test switch: 1 (default) skips the pairs the filter proves apart, 0
 /// gives every listed pair the exact test. The results are the same bit for
 /// bit; tests compare the two.

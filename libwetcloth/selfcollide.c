@@ -13,29 +13,32 @@
  * stacked layers; crossing edges are still stopped by the continuous test.
  *
  *  1. Broadphase. The triangles are grouped once, in the rest shape, into
- *     small connected patches (about 4 x 4 quads). Every particle gets a box
- *     around its motion x -> nx, grown by a margin g; patches get the union
- *     of their particles' boxes and a cone that holds every triangle normal
- *     of the patch over the whole step. A connected piece of surface whose
- *     normals all stay within 90 degrees of one direction is a height field
- *     over the plane across it and cannot pass through itself, as long as
- *     its projection onto that plane is one-to-one (the contour condition of
- *     Volino & Magnenat-Thalmann, not checked: an uncompressed compact patch
- *     cannot wind around itself without tearing, but a crushed free edge can
- *     fold over itself in the plane with every triangle still facing the
- *     same way; docs/model.md, Known gaps); within 60 degrees
- *     it cannot even bring two points closer than half their distance along
- *     the surface (see REST_EXCLUSION). So a patch with a narrow cone, and
- *     two patches sharing a vertex, or both sharing one with a third, whose
- *     joint cone is narrow, need no element tests at all. Only the other
- *     pairs of patches whose boxes come within the thickness h (a uniform
- *     grid finds them) are opened up into element pairs with overlapping
- *     boxes. A falling or draped cloth costs a pass over its particles and
- *     triangles; folds cost what they touch.
+ *     small connected patches (about 4 x 4 quads; pieces a bin's walls cut
+ *     off are merged into a neighbour). Every particle gets a box around its
+ *     motion x -> nx, grown by a margin g; patches get the union of their
+ *     particles' boxes and a cone that holds every triangle normal of the
+ *     patch over the whole step. A region of cloth (a patch, two side by
+ *     side, or two joined by a third) whose normals all stay within 90
+ *     degrees of one direction cannot pass through itself if it is an
+ *     oriented disk whose boundary, projected onto the plane across that
+ *     direction, stays a simple loop over the step: then the projection is
+ *     one-to-one, a height field (the contour condition of Volino &
+ *     Magnenat-Thalmann; contour.h has the argument). Without the contour
+ *     check a crushed free edge folding over itself in the plane, every
+ *     triangle still facing the same way, was culled and crossed itself.
+ *     Within 60 degrees a height field cannot even bring two points closer
+ *     than half their distance along the surface (see REST_EXCLUSION). So a
+ *     region with a narrow cone and a simple contour needs no element tests
+ *     at all. Only the other pairs of patches whose boxes come within the
+ *     thickness h (a uniform grid finds them) are opened up into element
+ *     pairs with overlapping boxes. A falling or draped cloth costs a pass
+ *     over its particles and triangles and one over the regions'
+ *     boundaries; folds cost what they touch.
  *     The candidates stay valid while every particle's motion stays inside
- *     its box and the culled patches keep their narrow cones: a response that
- *     breaks either triggers a rebuild, and the next step reuses them when
- *     neither broke (cloth at rest or moving slowly skips the broadphase).
+ *     its box and the culled regions keep their narrow cones and simple
+ *     contours: a response that breaks either triggers a rebuild, and the
+ *     next step reuses them when neither broke (cloth at rest or moving
+ *     slowly skips the broadphase).
  *  2. Passes. Each pass evaluates (in parallel, one status byte per pair)
  *     the pairs with a particle that moved since their last evaluation: the
  *     continuous test and, when that finds nothing, the distance at the end
@@ -71,6 +74,7 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "contour.h"
 #include "grid.h"
 #include "parallel.h"
 #include "primitives.h"
@@ -108,6 +112,8 @@
  * edge lengths, split into connected pieces of at most PATCH_MAX triangles. */
 #define PATCH_CELL_EDGES 4.0
 #define PATCH_MAX 64
+/* Patches smaller than this are merged into a neighbour (merge_small_patches). */
+#define PATCH_MIN 16
 /* After the first pass, proximity corrections smaller than this fraction of
  * the thickness are left alone: they would only buy more passes. */
 #define RESIDUAL 1e-3
@@ -119,6 +125,9 @@
 #define MIN_THICKNESS 0.01
 
 typedef struct pair_slice {
+    /// Scratch for the contour of a region (contour.h), room for the
+    /// boundaries of three patches.
+    wc_contour_segment *contour;
     int32_t *pairs;
     int64_t count, capacity;
     /// One double per pair where the pairs carry one (vertex-face: the
@@ -160,6 +169,17 @@ struct wc_self_state {
     /// particle with it (ascending, itself excluded). Owned particles and
     /// edges are tested once, from their own patch.
     csr patch_triangles, patch_particles, patch_owned_particles, patch_owned_edges, patch_adjacent;
+    /// Boundary half-edges of each patch (patch p's are boundary[3 k ..] for
+    /// k in [boundary_start[p], boundary_start[p + 1])): from, to (the
+    /// triangle's direction) and the patch across the edge (-1: none).
+    int32_t *boundary, *boundary_start;
+    /// Largest boundary of a patch, in half-edges.
+    int32_t boundary_most;
+    /// Whether each patch, and each adjacency entry's two patches together,
+    /// form an oriented disk (contour.h): only those can be culled.
+    uint8_t *patch_disk, *adjacent_disk;
+    /// Contour scratch for serial checks (still_valid).
+    wc_contour_segment *contour;
 
     /* Per step. */
     /// Particle boxes (motion grown by g); triangle boxes (corners' boxes
@@ -195,8 +215,10 @@ struct wc_self_state {
     double *vf_h;
     int64_t vf_h_capacity;
     /// Per particle: moved since its pairs were last evaluated; put back by
-    /// the fail-safe.
-    uint8_t *dirty, *reverted;
+    /// the fail-safe; moved at all by the last wci_self_collide (and how
+    /// many were).
+    uint8_t *dirty, *reverted, *moved;
+    int32_t moved_count;
     /// Whether the candidates were built (for the thickness built_h): a step
     /// whose motion stays inside the boxes and keeps the culling reuses them.
     int built;
@@ -256,6 +278,8 @@ static int grow_int32(int32_t **buf, int64_t *capacity, int64_t needed)
     *capacity = cap;
     return 1;
 }
+
+static int32_t max2i(int32_t a, int32_t b) { return a > b ? a : b; }
 
 static int sorted_contains(const int32_t *list, int32_t count, int32_t item)
 {
@@ -398,9 +422,61 @@ static int compare_bins(const void *pa, const void *pb)
     return p->triangle < q->triangle ? -1 : (p->triangle > q->triangle);
 }
 
+static int32_t group_of(int32_t *root, int32_t p)
+{
+    while (root[p] != p) p = root[p] = root[root[p]];
+    return p;
+}
+
+/* Patches of fewer than PATCH_MIN triangles are pieces of a bin that its
+ * walls cut off: along a grid cloth's border, where the walls run between
+ * the two triangles of each quad, single triangles. Each is merged, in patch
+ * order, into the smallest patch across one of its edges that has room
+ * (lowest index on a tie), so every patch stays connected; fewer patches
+ * mean fewer pairs of them and shorter boundaries in all (20 x 20 cloth: 98
+ * patches, 58 of them single triangles, before). Renumbers triangle_patch;
+ * returns the new count, or -1 on out-of-memory. */
+static int32_t merge_small_patches(wc_self_state *s, const int32_t *neighbours, int32_t patches)
+{
+    int32_t nt = s->triangle_count;
+    int32_t *size = wci_alloc_array((size_t)patches + 1, sizeof *size);
+    int32_t *root = wci_alloc_array((size_t)patches + 1, sizeof *root);
+    int32_t *start = wci_alloc_array((size_t)patches + 2, sizeof *start);
+    int32_t *order = wci_alloc_array((size_t)nt + 1, sizeof *order);
+    int32_t count = -1;
+    if (size && root && start && order) {
+        for (int32_t t = 0; t < nt; ++t) ++start[s->triangle_patch[t] + 2];
+        for (int32_t p = 0; p < patches; ++p) start[p + 2] += start[p + 1], root[p] = p;
+        for (int32_t t = 0; t < nt; ++t) order[start[s->triangle_patch[t] + 1]++] = t;
+        /* start[p] .. start[p + 1] now holds patch p's triangles */
+        for (int32_t p = 0; p < patches; ++p) size[p] = start[p + 1] - start[p];
+        for (int32_t p = 0; p < patches; ++p) {
+            int32_t g = group_of(root, p), best = -1;
+            if (size[g] >= PATCH_MIN) continue;
+            for (int32_t k = start[p]; k < start[p + 1]; ++k)
+                for (int j = 0; j < 3; ++j) {
+                    int32_t u = neighbours[3 * (size_t)order[k] + j];
+                    if (u < 0) continue;
+                    int32_t h = group_of(root, s->triangle_patch[u]);
+                    if (h == g || size[g] + size[h] > PATCH_MAX) continue;
+                    if (best < 0 || size[h] < size[best] || (size[h] == size[best] && h < best)) best = h;
+                }
+            if (best >= 0) root[g] = best, size[best] += size[g];
+        }
+        count = 0;
+        for (int32_t p = 0; p < patches; ++p) start[p] = group_of(root, p) == p ? count++ : -1;
+        for (int32_t t = 0; t < nt; ++t) s->triangle_patch[t] = start[group_of(root, s->triangle_patch[t])];
+    }
+    wci_free(size);
+    wci_free(root);
+    wci_free(start);
+    wci_free(order);
+    return count;
+}
+
 /* Patches: the triangles of each bin, lowest index first, grown breadth-first
- * across manifold edges within the bin up to PATCH_MAX triangles. Each patch
- * is connected, which the culling needs. */
+ * across manifold edges within the bin up to PATCH_MAX triangles, small ones
+ * merged into a neighbour. Each patch is connected, which the culling needs. */
 static int build_patches(wc_self_state *s, const int32_t *neighbours)
 {
     int32_t nt = s->triangle_count, n = s->particle_count;
@@ -445,7 +521,8 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
              * the patch is exactly queue[0 .. tail). */
             ++patches;
         }
-        s->patch_count = patches;
+        s->patch_count = merge_small_patches(s, neighbours, patches);
+        ok = s->patch_count >= 0;
     }
     wci_free(bins);
     wci_free(bin_of);
@@ -518,6 +595,77 @@ static int build_patches(wc_self_state *s, const int32_t *neighbours)
     return ok;
 }
 
+/* Whether the triangles of one patch, or of two together, form an oriented
+ * disk; halves and vertices hold 3 * (their triangle count) entries. */
+static int patches_disk(const wc_self_state *s, int32_t p, int32_t q, int32_t *list,
+                        wc_half_edge *halves, int32_t *vertices)
+{
+    const csr *pt = &s->patch_triangles;
+    int32_t count = 0;
+    for (int32_t k = pt->start[p]; k < pt->start[p + 1]; ++k) list[count++] = pt->items[k];
+    for (int32_t k = q >= 0 ? pt->start[q] : 0; q >= 0 && k < pt->start[q + 1]; ++k)
+        list[count++] = pt->items[k];
+    return wci_region_is_disk(s->triangles, list, count, halves, vertices);
+}
+
+/* Each patch's boundary half-edges and which patches, alone and in adjacent
+ * pairs, are oriented disks (the contour condition's topology, fixed by the
+ * rest mesh). */
+static int build_contours(wc_self_state *s, const int32_t *neighbours)
+{
+    int32_t np = s->patch_count, most = 0;
+    const csr *pt = &s->patch_triangles, *adj = &s->patch_adjacent;
+    s->boundary_start = wci_alloc_array((size_t)np + 1, sizeof *s->boundary_start);
+    s->patch_disk = wci_alloc_array((size_t)np, 1);
+    s->adjacent_disk = wci_alloc_array((size_t)adj->start[np] + 1, 1);
+    if (!s->boundary_start || !s->patch_disk || !s->adjacent_disk) return 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        int32_t at = 0;
+        for (int32_t p = 0; p < np; ++p) {
+            s->boundary_start[p] = at;
+            for (int32_t k = pt->start[p]; k < pt->start[p + 1]; ++k) {
+                int32_t t = pt->items[k];
+                const int32_t *tri = s->triangles + 3 * (size_t)t;
+                for (int j = 0; j < 3; ++j) {
+                    int32_t across = neighbours[3 * (size_t)t + j];
+                    int32_t other = across < 0 ? -1 : s->triangle_patch[across];
+                    if (other == p) continue;
+                    if (pass) {
+                        int32_t *b = s->boundary + 3 * (size_t)at;
+                        b[0] = tri[j], b[1] = tri[(j + 1) % 3], b[2] = other;
+                    }
+                    ++at;
+                }
+            }
+            most = max2i(most, at - s->boundary_start[p]);
+        }
+        s->boundary_start[np] = at;
+        if (!pass && !(s->boundary = wci_alloc_array(3 * (size_t)at + 3, sizeof *s->boundary))) return 0;
+    }
+    s->boundary_most = most;
+    int32_t largest = 0;
+    for (int32_t p = 0; p < np; ++p) largest = max2i(largest, pt->start[p + 1] - pt->start[p]);
+    int32_t *list = wci_alloc_array(2 * (size_t)largest, sizeof *list);
+    int32_t *vertices = wci_alloc_array(6 * (size_t)largest, sizeof *vertices);
+    wc_half_edge *halves = wci_alloc_array(6 * (size_t)largest, sizeof *halves);
+    int ok = list && vertices && halves;
+    for (int32_t p = 0; p < np && ok; ++p) {
+        s->patch_disk[p] = (uint8_t)patches_disk(s, p, -1, list, halves, vertices);
+        for (int32_t k = adj->start[p]; k < adj->start[p + 1]; ++k) {
+            int32_t q = adj->items[k];
+            if (q < p) continue;
+            uint8_t disk = (uint8_t)patches_disk(s, p, q, list, halves, vertices);
+            s->adjacent_disk[k] = disk;
+            s->adjacent_disk[adj->start[q] + sorted_contains(adj->items + adj->start[q],
+                                                              adj->start[q + 1] - adj->start[q], p)] = disk;
+        }
+    }
+    wci_free(list);
+    wci_free(vertices);
+    wci_free(halves);
+    return ok;
+}
+
 /* Copies the pieces into the state: each particle's and each patch's piece
  * and the per-piece settings. */
 static int set_pieces(wc_self_state *s, const wc_self_pieces *pieces)
@@ -553,6 +701,12 @@ void wci_self_state_invalidate(wc_self_state *s) { s->built = 0; }
 
 const double *wci_self_state_rest(const wc_self_state *s) { return s->rest; }
 
+const uint8_t *wci_self_state_moved(const wc_self_state *s, int32_t *count)
+{
+    *count = s->moved_count;
+    return s->moved;
+}
+
 wc_self_state *wci_self_state_create(const wc_cloth *c) { return wci_self_state_create_pieces(c, NULL); }
 
 wc_self_state *wci_self_state_create_pieces(const wc_cloth *c, const wc_self_pieces *pieces)
@@ -571,7 +725,7 @@ wc_self_state *wci_self_state_create_pieces(const wc_cloth *c, const wc_self_pie
     int ok = s->rest && neighbours && build_edges(s, c, neighbours);
     if (ok) {
         for (size_t i = 0; i < n; ++i) load(c->x, c->y, c->z, (int32_t)i, s->rest + 3 * i);
-        ok = build_patches(s, neighbours);
+        ok = build_patches(s, neighbours) && build_contours(s, neighbours);
     }
     wci_free(neighbours);
     if (!ok) {
@@ -595,9 +749,15 @@ wc_self_state *wci_self_state_create_pieces(const wc_cloth *c, const wc_self_pie
     s->adjacent_culled = wci_alloc_array(adjacency, 1);
     s->dirty = wci_alloc_array(n, 1);
     s->reverted = wci_alloc_array(n, 1);
-    if (!s->particle_boxes || !s->triangle_boxes || !s->edge_boxes || !s->triangle_normals ||
+    s->moved = wci_alloc_array(n, 1);
+    size_t region_most = 3 * (size_t)s->boundary_most + 1;
+    s->contour = wci_alloc_array(region_most, sizeof *s->contour);
+    int slices_ok = 1;
+    for (int k = 0; k < SLICES; ++k)
+        slices_ok = slices_ok && (s->slices[k].contour = wci_alloc_array(region_most, sizeof *s->contour));
+    if (!slices_ok || !s->contour || !s->particle_boxes || !s->triangle_boxes || !s->edge_boxes || !s->triangle_normals ||
         !s->patch_boxes || !s->patch_grown || !s->patch_axis || !s->patch_cos || !s->patch_fit ||
-        !s->patch_culled || !s->patch_touched || !s->adjacent_culled || !s->dirty || !s->reverted ||
+        !s->patch_culled || !s->patch_touched || !s->adjacent_culled || !s->dirty || !s->reverted || !s->moved ||
         !s->rest_triangle_boxes || !s->rest_edge_boxes) {
         wci_self_state_destroy(s);
         return NULL;
@@ -631,9 +791,10 @@ void wci_self_state_destroy(wc_self_state *s)
                       s->particle_boxes, s->triangle_boxes, s->edge_boxes, s->triangle_normals,
                       s->patch_boxes, s->patch_grown, s->patch_axis, s->patch_cos, s->patch_fit,
                       s->patch_culled, s->adjacent_culled, s->patch_touched, s->open, s->joined, s->vf,
-                      s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted, s->vf_h,
+                      s->ee, s->vf_status, s->ee_status, s->dirty, s->reverted, s->moved, s->vf_h,
                       s->particle_piece, s->patch_piece, s->piece_self, s->piece_friction,
-                      s->piece_wet_friction};
+                      s->piece_wet_friction, s->boundary, s->boundary_start, s->patch_disk,
+                      s->adjacent_disk, s->contour};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wci_free(blocks[k]);
     csr_free(&s->patch_triangles);
     csr_free(&s->patch_particles);
@@ -645,6 +806,7 @@ void wci_self_state_destroy(wc_self_state *s)
         wci_free(s->slices[k].pairs);
         wci_free(s->slices[k].values);
         wci_free(s->slices[k].query);
+        wci_free(s->slices[k].contour);
     }
     wci_free(s);
 }
@@ -752,9 +914,9 @@ static int fits_cone(const wc_self_state *s, int32_t p, double c)
  * acos(CONE_COS) around d, the normalised sum of their axes: a normal is at
  * most its patch's half-angle plus the angle between that patch's axis and
  * d away from d. */
-static int cones_fit(const wc_self_state *s, const int32_t *patches, int count)
+static int cones_fit(const wc_self_state *s, const int32_t *patches, int count, double d[3])
 {
-    double d[3] = {0.0, 0.0, 0.0};
+    d[0] = d[1] = d[2] = 0.0;
     for (int k = 0; k < count; ++k) {
         if (!(s->patch_cos[patches[k]] > CONE_COS)) return 0;
         for (int m = 0; m < 3; ++m) d[m] += s->patch_axis[3 * (size_t)patches[k] + m];
@@ -765,9 +927,46 @@ static int cones_fit(const wc_self_state *s, const int32_t *patches, int count)
     return 1;
 }
 
+/* Whether patches[0 .. count) (1 to 3, each adjacent to the next) can skip
+ * their element tests over the current motion: their normals within
+ * acos(CONE_COS) of one direction d, their triangles an oriented disk, and
+ * the disk's boundary projected along d simple over the step (contour.h).
+ * contour is scratch for three patches' boundaries. */
+static int region_culls(const wc_self_state *s, const wc_cloth *c, const int32_t *patches, int count,
+                        wc_contour_segment *contour)
+{
+    double d[3];
+    if (count == 1) {
+        if (!(s->patch_cos[patches[0]] > CONE_COS) || !s->patch_disk[patches[0]]) return 0;
+        memcpy(d, s->patch_axis + 3 * (size_t)patches[0], sizeof d);
+    } else {
+        if (!cones_fit(s, patches, count, d)) return 0;
+        const csr *adj = &s->patch_adjacent;
+        for (int k = 0; k + 1 < count; ++k) {
+            int32_t p = patches[k], q = patches[k + 1];
+            int32_t at = sorted_contains(adj->items + adj->start[p], adj->start[p + 1] - adj->start[p], q);
+            if (at < 0 || !s->adjacent_disk[adj->start[p] + at]) return 0;
+        }
+    }
+    /* The region's boundary: its patches' boundaries less the edges they
+     * share. */
+    int32_t segments = 0;
+    for (int k = 0; k < count; ++k)
+        for (int32_t m = s->boundary_start[patches[k]]; m < s->boundary_start[patches[k] + 1]; ++m) {
+            const int32_t *b = s->boundary + 3 * (size_t)m;
+            int inner = 0;
+            for (int j = 0; j < count; ++j) inner |= b[2] == patches[j];
+            if (inner) continue;
+            contour[segments].from = b[0], contour[segments].to = b[1];
+            ++segments;
+        }
+    return wci_contour_simple(contour, segments, d, c->x, c->y, c->z, c->nx, c->ny, c->nz, s->mean_edge);
+}
+
 /* A common neighbour r of non-adjacent patches p and q through which the
- * three form one connected region within a common cone, or -1. */
-static int32_t joining_patch(const wc_self_state *s, int32_t p, int32_t q)
+ * three form one connected region that can be culled, or -1. */
+static int32_t joining_patch(const wc_self_state *s, const wc_cloth *c, int32_t p, int32_t q,
+                             wc_contour_segment *contour)
 {
     const csr *adj = &s->patch_adjacent;
     int32_t i = adj->start[p], j = adj->start[q];
@@ -779,7 +978,7 @@ static int32_t joining_patch(const wc_self_state *s, int32_t p, int32_t q)
             ++j;
         } else {
             int32_t three[3] = {p, a, q};
-            if (cones_fit(s, three, 3)) return a;
+            if (region_culls(s, c, three, 3, contour)) return a;
             ++i, ++j;
         }
     }
@@ -790,9 +989,11 @@ static int32_t joining_patch(const wc_self_state *s, int32_t p, int32_t q)
  * Q >= P whose grown box meets P's box, as triples (P, Q, how): how = -1 for
  * a pair to open, -2 for neighbours culled together, r >= 0 for patches two
  * apart culled together with their common neighbour r. */
-static void patch_pairs_slice(wc_self_state *s, pair_slice *sl, int32_t first, int32_t end)
+static void patch_pairs_slice(wc_self_state *s, const wc_cloth *c, pair_slice *sl, int32_t first,
+                              int32_t end)
 {
     for (int32_t p = first; p < end && !sl->failed; ++p) {
+        s->patch_culled[p] = 0;
         int32_t found;
         for (;;) {
             found = wci_grid_query(&s->patch_grid, s->patch_boxes + 6 * (size_t)p, sl->query,
@@ -815,13 +1016,15 @@ static void patch_pairs_slice(wc_self_state *s, pair_slice *sl, int32_t first, i
                 !s->piece_self[s->patch_piece[p]])
                 continue;
             if (q == p) {
-                if (s->patch_cos[p] > CONE_COS) continue;
+                /* p is only in this slice: its flag is this thread's */
+                s->patch_culled[p] = (uint8_t)region_culls(s, c, &p, 1, sl->contour);
+                if (s->patch_culled[p]) continue;
                 how = -1;
             } else if (sorted_contains(adj, adj_count, q) >= 0) {
                 int32_t two[2] = {p, q};
-                how = cones_fit(s, two, 2) ? -2 : -1;
+                how = region_culls(s, c, two, 2, sl->contour) ? -2 : -1;
             } else {
-                how = joining_patch(s, p, q);
+                how = joining_patch(s, c, p, q, sl->contour);
                 if (how < 0) how = -1;
             }
             if (!grow_int32(&sl->pairs, &sl->capacity, 3 * (sl->count + 1))) {
@@ -1099,13 +1302,12 @@ static wc_status broadphase(wc_self_state *s, const wc_cloth *c, const self_ctx 
     for (int k = 0; k < SLICES; ++k) s->slices[k].count = 0, s->slices[k].failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (nt >= WC_PARALLEL_MIN)
     for (int k = 0; k < SLICES; ++k)
-        patch_pairs_slice(s, &s->slices[k], slice_begin(np, k), slice_begin(np, k + 1));
+        patch_pairs_slice(s, c, &s->slices[k], slice_begin(np, k), slice_begin(np, k + 1));
     if (!gather(s->slices, 3, &s->open, NULL, &s->open_count, &s->open_capacity))
         return WC_ERROR_OUT_OF_MEMORY;
     /* Culling decisions (serial: few): patches alone, neighbours (a flag per
      * adjacency entry, both ways), patches two apart (triples); the pairs to
      * open are compacted in place to (P, Q). */
-    for (int32_t p = 0; p < np; ++p) s->patch_culled[p] = s->patch_cos[p] > CONE_COS;
     memset(s->adjacent_culled, 0, (size_t)s->patch_adjacent.start[np]);
     const csr *adj = &s->patch_adjacent;
     int64_t open = 0, joined = 0;
@@ -1419,6 +1621,12 @@ static void pair_friction(const wc_cloth *c, const wc_self_state *s, const self_
  * h (elements that start touching are parted a little, or the continuous
  * test would find them again); a proximity's target is h. Returns whether
  * any particle moved. */
+static void note_moved(wc_self_state *s, int32_t i)
+{
+    s->dirty[i] = 1;
+    if (!s->moved[i]) s->moved[i] = 1, ++s->moved_count;
+}
+
 static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, const double friction[2],
                    double slack, int32_t *marked)
 {
@@ -1440,7 +1648,7 @@ static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, const d
     uint8_t moved[4];
     if (!wci_response_apply(&p, &ct, &options, marked, moved)) return 0;
     for (int j = 0; j < 4; ++j)
-        if (moved[j]) s->dirty[k->p[j]] = 1;
+        if (moved[j]) note_moved(s, k->p[j]);
     return 1;
 }
 
@@ -1509,19 +1717,21 @@ static int still_valid(wc_self_state *s, const wc_cloth *c, int threads)
     if (!any) return 1;
     for (int32_t p = 0; p < s->patch_count; ++p) {
         if (!s->patch_touched[p]) continue;
-        if (s->patch_culled[p] && !(s->patch_cos[p] > CONE_COS)) return 0;
+        if (s->patch_culled[p] && !region_culls(s, c, &p, 1, s->contour)) return 0;
         for (int32_t k = adj->start[p]; k < adj->start[p + 1]; ++k) {
             /* both entries of a pair are flagged: check it from one side,
              * from the other when that one was not touched */
-            int32_t q = adj->items[k], two[2] = {p, q};
+            int32_t q = adj->items[k], two[2] = {p < q ? p : q, p < q ? q : p};
             if (q < p && s->patch_touched[q]) continue;
-            if (s->adjacent_culled[k] && !cones_fit(s, two, 2)) return 0;
+            if (s->adjacent_culled[k] && !region_culls(s, c, two, 2, s->contour)) return 0;
         }
     }
     for (int64_t k = 0; k < s->joined_count; ++k) {
-        const int32_t *three = s->joined + 3 * k;
-        if ((s->patch_touched[three[0]] || s->patch_touched[three[1]] || s->patch_touched[three[2]]) &&
-            !cones_fit(s, three, 3))
+        /* stored as (P, Q, R), culled as the chain P, R, Q (joining_patch) */
+        const int32_t *j = s->joined + 3 * k;
+        int32_t three[3] = {j[0], j[2], j[1]};
+        if ((s->patch_touched[j[0]] || s->patch_touched[j[1]] || s->patch_touched[j[2]]) &&
+            !region_culls(s, c, three, 3, s->contour))
             return 0;
     }
     return 1;
@@ -1534,7 +1744,7 @@ static void revert(wc_cloth *c, wc_self_state *s, int32_t i)
     c->qx[i] = c->x[i], c->qy[i] = c->y[i], c->qz[i] = c->z[i];
     c->history_override[i] = 1;
     s->reverted[i] = 1;
-    s->dirty[i] = 1;
+    note_moved(s, i);
 }
 
 /* Reverts every free particle of every pair whose motion still collides,
@@ -1608,12 +1818,9 @@ double wci_self_thickness(const wc_cloth *c)
     return max2(c->material.thickness, MIN_THICKNESS * c->self->mean_edge);
 }
 
-wc_status wci_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *stats)
+static self_ctx context_of(const wc_cloth *c)
 {
-    (void)dt; /* everything works in displacements over the step */
-    wc_self_state *s = c->self;
-    if (!s || s->triangle_count == 0) return WC_OK;
-    if (threads < 1) threads = 1;
+    const wc_self_state *s = c->self;
     self_ctx ctx;
     ctx.h = wci_self_thickness(c);
     ctx.tol = CCD_TOLERANCE * ctx.h;
@@ -1622,6 +1829,38 @@ wc_status wci_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *s
     ctx.piece = s->particle_piece;
     /* nx/ny/nz are the cloth's current arrays (they swap at commit). */
     ctx.x = c->x, ctx.y = c->y, ctx.z = c->z, ctx.nx = c->nx, ctx.ny = c->ny, ctx.nz = c->nz;
+    return ctx;
+}
+
+wc_status wci_self_verify(wc_cloth *c, const uint8_t *moved, int threads, wc_step_stats *stats)
+{
+    wc_self_state *s = c->self;
+    if (!s || s->triangle_count == 0) return WC_OK;
+    if (threads < 1) threads = 1;
+    self_ctx ctx = context_of(c);
+    double g = BOX_MARGIN * ctx.h;
+    memset(s->dirty, 0, (size_t)s->particle_count);
+    for (int32_t i = 0; i < s->particle_count; ++i) s->dirty[i] = moved[i];
+    if (!(s->built && s->built_h == ctx.h) || !still_valid(s, c, threads)) {
+        s->built = 0;
+        if (broadphase(s, c, &ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+        s->built = 1, s->built_h = ctx.h;
+        memset(s->dirty, 1, (size_t)s->particle_count);
+    }
+    evaluate(s, &ctx, 1, threads);
+    int32_t reverted = 0;
+    if (failsafe(c, s, &ctx, g, threads, &reverted)) return WC_ERROR_OUT_OF_MEMORY;
+    if (stats) stats->failsafe_particles += reverted;
+    return WC_OK;
+}
+
+wc_status wci_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *stats)
+{
+    (void)dt; /* everything works in displacements over the step */
+    wc_self_state *s = c->self;
+    if (!s || s->triangle_count == 0) return WC_OK;
+    if (threads < 1) threads = 1;
+    self_ctx ctx = context_of(c);
     double g = BOX_MARGIN * ctx.h;
     int32_t marked = 0, reverted = 0;
     /* Candidates from an earlier step hold as long as every particle's
@@ -1629,6 +1868,8 @@ wc_status wci_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *s
      * (still_valid with every particle marked): cloth at rest or moving
      * slowly skips the broadphase. */
     s->cones_current = 0; /* the cloth has moved since the last step */
+    if (s->moved_count) memset(s->moved, 0, (size_t)s->particle_count);
+    s->moved_count = 0;
     int rebuild = !(s->built && s->built_h == ctx.h);
     if (!rebuild) {
         memset(s->dirty, 1, (size_t)s->particle_count);

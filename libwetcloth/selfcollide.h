@@ -44,6 +44,10 @@ void wci_self_state_invalidate(wc_self_state *state);
 /// The rest shape the state was made with, xyz per particle.
 const double *wci_self_state_rest(const wc_self_state *state);
 
+/// The particles the last wci_self_collide moved (one flag each), and how
+/// many: the collider stage checks them again (collider_contacts.h).
+const uint8_t *wci_self_state_moved(const wc_self_state *state, int32_t *count);
+
 /// Resolves self-collisions of the motion from (x, y, z) to (nx, ny, nz):
 /// moves nx/ny/nz, sets the history override (qx/qy/qz, history_override)
 /// where it changes velocities through the previous position, and marks
@@ -51,6 +55,13 @@ const double *wci_self_state_rest(const wc_self_state *state);
 /// move. Adds to stats->cloth_contacts and stats->failsafe_particles.
 /// Deterministic for any thread count.
 wc_status wci_self_collide(wc_cloth *cloth, double dt, int threads, wc_step_stats *stats);
+
+/// After the collider stage moved some particles again (flags in moved)
+/// once wci_self_collide was done: detects the pairs of their new motion
+/// that collide and puts them back as its fail-safe does, so the step still
+/// ends free of intersection between layers. Adds to
+/// stats->failsafe_particles. Deterministic for any thread count.
+wc_status wci_self_verify(wc_cloth *cloth, const uint8_t *moved, int threads, wc_step_stats *stats);
 
 /// The thickness self-collision keeps between layers of a cloth that has
 /// self-collision: the material's, but at least a small fraction of the mean

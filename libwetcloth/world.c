@@ -209,6 +209,36 @@ static wc_status guard_steps(wc_world *w, double dt, int threads)
  * then answers to the relative motion. `share` is the part of what is left
  * of the advance that this step covers, `steps_left` how many steps of it
  * follow this one. */
+/* What self-collision or the collision between cloths moved may now lie
+ * against a collider feature the collider stage saw clear (a triangle pushed
+ * down onto a proud vertex), so the collider stage runs again over it; what
+ * that moves in turn is checked against the other layers (for a cloth of the
+ * group, by wci_cloth_group_verify once every member is done), whose
+ * fail-safe puts colliding pairs back where the step started, free of both. */
+static wc_status recheck_colliders(wc_world *w, const step_context *ctx, int32_t c, int alone)
+{
+    wc_cloth *cl = w->cloths[c];
+    int32_t moved = 0;
+    const uint8_t *flags = NULL, *changed = NULL;
+    if (!alone) flags = wci_cloth_group_moved(w->group, c, &moved);
+    else if (cl->self) flags = wci_self_state_moved(cl->self, &moved);
+    if (!moved || !cl->collider_contacts) return WC_OK;
+    if (wci_collider_contacts_recheck(cl, cl->collider_contacts, w->colliders, w->collider_count,
+                                      flags, ctx->steps_left, ctx->threads, &w->stats, &changed))
+        return WC_ERROR_OUT_OF_MEMORY;
+    if (!changed) return WC_OK;
+    if (alone) return wci_self_verify(cl, changed, ctx->threads, &w->stats);
+    memcpy(wci_cloth_group_flags(w->group, c), changed, (size_t)cl->particle_count);
+    return WC_OK;
+}
+
+static wc_status between_cloths_failed(wc_world *w)
+{
+    return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                   "out of memory in the collision between cloths; the world keeps its last good "
+                   "state");
+}
+
 static wc_status collide(wc_world *w, const step_context *ctx)
 {
     double dt = ctx->dt;
@@ -242,9 +272,7 @@ static wc_status collide(wc_world *w, const step_context *ctx)
     /* cloths against each other, after all their collider passes */
     if (wci_cloth_group_update(&w->group, w->cloths, w->cloth_count) ||
         (w->group && wci_cloth_group_collide(w->group, w->cloths, dt, threads, &w->stats)))
-        return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
-                       "out of memory in the collision between cloths; the world keeps its last "
-                       "good state");
+        return between_cloths_failed(w);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
         wc_cloth *cl = w->cloths[c];
         int alone = !wci_cloth_group_handled(w->group, c);
@@ -252,6 +280,16 @@ static wc_status collide(wc_world *w, const step_context *ctx)
             return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory in the self-collision of cloth %d; the world keeps its "
                            "last good state", (int)c);
+        if (recheck_colliders(w, ctx, c, alone))
+            return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
+                           "out of memory in the collisions of cloth %d; the world keeps its last "
+                           "good state", (int)c);
+    }
+    if (w->group && wci_cloth_group_verify(w->group, w->cloths, threads, &w->stats))
+        return between_cloths_failed(w);
+    for (int32_t c = 0; c < w->cloth_count; ++c) {
+        wc_cloth *cl = w->cloths[c];
+        int alone = !wci_cloth_group_handled(w->group, c);
         if (alone && cl->self && cl->wet_forces && wci_wet_self_pairs(cl, wci_self_thickness(cl)))
             return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,
                            "out of memory for the self-adhesion of cloth %d; the world keeps its "

@@ -19,7 +19,13 @@
  *      rest on it with no intersection in any frame, the same bits on 1 and
  *      4 threads; with collide_with_cloths = 0 on the thrown one it passes
  *      through (the checker sees it), so the flag is what keeps them apart.
- * (a)-(d) drive wci_self_collide directly on a cloth's internal arrays, with
+ *  (g) the normal-cone cull's contour condition (contour.h): which
+ *      triangle sets are oriented disks; which projected boundary motions
+ *      stay simple; and a U-shaped cloth whose arm slides in its own plane
+ *      over the other arm and down through it in one step, every triangle
+ *      facing up throughout, is stopped: the cone alone would skip the
+ *      region's element tests.
+ * (a)-(d), (g) drive wci_self_collide directly on a cloth's internal arrays, with
  * a brute-force check (every vertex-face and edge-edge pair, no broadphase)
  * of what remains. */
 #include <math.h>
@@ -28,6 +34,7 @@
 #include <string.h>
 
 #include "cloth.h"
+#include "contour.h"
 #include "primitives.h"
 #include "scenes.h"
 #include "selfcollide.h"
@@ -631,6 +638,150 @@ static void test_two_cloths(void)
           through_gap);
 }
 
+/* ------------------------------------------------------------------------ */
+/* (g) the contour condition                                                */
+/* ------------------------------------------------------------------------ */
+
+/* A flat U of quads on a 4 x 5 grid of unit spacing (particle i + 4 j at
+ * (i, j, 0)): the base row of three quads, and one quad wide arms over
+ * columns 0 and 2, three rows high. 9 quads, 18 triangles, all facing +z. */
+enum { U_PARTICLES = 20, U_TRIANGLES = 18 };
+static void u_shape(double *xyz, int32_t *tris)
+{
+    for (int j = 0; j < 5; ++j)
+        for (int i = 0; i < 4; ++i) {
+            double *p = xyz + 3 * (i + 4 * j);
+            p[0] = i, p[1] = j, p[2] = 0.0;
+        }
+    int32_t t = 0;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 3; ++i) {
+            if (j > 0 && i == 1) continue;
+            int32_t a = i + 4 * j, b = a + 1, c = a + 5, d = a + 4;
+            int32_t q[6] = {a, b, c, a, c, d};
+            memcpy(tris + 3 * t, q, sizeof q);
+            t += 2;
+        }
+}
+
+static int disk(const int32_t *tris, int32_t count)
+{
+    int32_t list[64], vertices[192];
+    wc_half_edge halves[192];
+    for (int32_t k = 0; k < count; ++k) list[k] = k;
+    return wci_region_is_disk(tris, list, count, halves, vertices);
+}
+
+/* Boundary half-edges of triangles tris[0 .. count) (brute force). */
+static int32_t boundary_of(const int32_t *tris, int32_t count, wc_contour_segment *out)
+{
+    int32_t n = 0;
+    for (int32_t t = 0; t < count; ++t)
+        for (int k = 0; k < 3; ++k) {
+            int32_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3], twin = 0;
+            for (int32_t u = 0; u < count; ++u)
+                for (int m = 0; m < 3; ++m) twin |= tris[3 * u + m] == b && tris[3 * u + (m + 1) % 3] == a;
+            if (!twin) out[n].from = a, out[n].to = b, ++n;
+        }
+    return n;
+}
+
+static void test_contour(void)
+{
+    double xyz[3 * U_PARTICLES];
+    int32_t tris[3 * U_TRIANGLES];
+    u_shape(xyz, tris);
+    /* Topology. */
+    int32_t annulus[3 * 16], at = 0; /* 3 x 3 quads less the middle one */
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) {
+            if (i == 1 && j == 1) continue;
+            int32_t a = i + 4 * j, q[6] = {a, a + 1, a + 5, a, a + 5, a + 4};
+            memcpy(annulus + at, q, sizeof q);
+            at += 6;
+        }
+    int32_t bowtie[6] = {0, 1, 5, 5, 6, 10};      /* two triangles sharing particle 5 */
+    int32_t flipped[6] = {0, 1, 5, 0, 4, 5};      /* the second turned over */
+    int32_t fin[9] = {0, 1, 5, 1, 0, 4, 0, 1, 8}; /* edge 0-1 in three triangles */
+    int32_t apart[6] = {0, 1, 5, 10, 11, 15};
+    int u = disk(tris, U_TRIANGLES), a = disk(annulus, 16), b = disk(bowtie, 2), f = disk(flipped, 2),
+        three = disk(fin, 3), two = disk(apart, 2), one = disk(tris, 1);
+    printf("contour: disks: U %d, annulus %d, bowtie %d, flipped %d, three on an edge %d, apart %d, "
+           "one triangle %d\n",
+           u, a, b, f, three, two, one);
+    CHECK(u && one, "a U of quads, or one triangle, is not taken for a disk");
+    CHECK(!a && !b && !f && !three && !two, "a set that is no oriented disk is taken for one");
+
+    /* Boundary motions, projected along z. */
+    const double up[3] = {0.0, 0.0, 1.0};
+    wc_contour_segment seg[64];
+    double x[U_PARTICLES], y[U_PARTICLES], z[U_PARTICLES], nx[U_PARTICLES], ny[U_PARTICLES],
+        nz[U_PARTICLES];
+    for (int i = 0; i < U_PARTICLES; ++i) {
+        x[i] = nx[i] = xyz[3 * i], y[i] = ny[i] = xyz[3 * i + 1], z[i] = nz[i] = xyz[3 * i + 2];
+        nx[i] += 0.3, ny[i] -= 0.2, nz[i] += 0.5; /* a rigid shift */
+    }
+    int32_t n = boundary_of(tris, U_TRIANGLES, seg);
+    int still = wci_contour_simple(seg, n, up, x, y, z, nx, ny, nz, 1.0);
+    /* arm 0's top two rows slide over arm 2 (x + 2) */
+    for (int i = 0; i < U_PARTICLES; ++i) nx[i] = x[i], ny[i] = y[i], nz[i] = z[i];
+    for (int j = 2; j < 5; ++j)
+        for (int i = 0; i < 2; ++i) nx[i + 4 * j] += 2.0;
+    n = boundary_of(tris, U_TRIANGLES, seg);
+    int slid = wci_contour_simple(seg, n, up, x, y, z, nx, ny, nz, 1.0);
+    /* the same, stopped a quarter short of the other arm: apart all along */
+    for (int j = 2; j < 5; ++j)
+        for (int i = 0; i < 2; ++i) nx[i + 4 * j] -= 1.75;
+    n = boundary_of(tris, U_TRIANGLES, seg);
+    int short_of = wci_contour_simple(seg, n, up, x, y, z, nx, ny, nz, 1.0);
+    /* one triangle whose corner passes over the opposite edge: its two
+     * boundary edges at that corner's neighbour fold onto each other */
+    double tx[3] = {0.0, 1.0, 0.5}, ty[3] = {0.0, 0.0, 1.0}, tz[3] = {0.0, 0.0, 0.0};
+    double ux[3] = {0.0, 1.0, 0.5}, uy[3] = {0.0, 0.0, -1.0}, uz[3] = {0.0, 0.0, 0.0};
+    int32_t one_tri[3] = {0, 1, 2};
+    n = boundary_of(one_tri, 1, seg);
+    int folded = wci_contour_simple(seg, n, up, tx, ty, tz, ux, uy, uz, 1.0);
+    printf("contour: U shifted rigidly: simple %d; an arm slid over the other: %d; slid to a quarter "
+           "short: %d; a triangle turned over in its plane: %d\n",
+           still, slid, short_of, folded);
+    CHECK(still && short_of, "a boundary that stays simple is not taken for simple");
+    CHECK(!slid && !folded, "a boundary that crosses itself is taken for simple");
+}
+
+/* The U as a cloth (thickness 0.05, unit quads): arm 0's top two rows start
+ * 0.3 above the plane and in one step slide over arm 2 and down to 0.3
+ * below it, every triangle still facing up. */
+static void test_in_plane_fold(void)
+{
+    double xyz[3 * U_PARTICLES];
+    int32_t tris[3 * U_TRIANGLES];
+    u_shape(xyz, tris);
+    wc_world *w = new_world(1);
+    wc_cloth *c = add_mesh(w, xyz, U_PARTICLES, tris, U_TRIANGLES, 0.05);
+    if (!c) {
+        wc_world_destroy(w);
+        return;
+    }
+    for (int32_t i = 0; i < U_PARTICLES; ++i) {
+        int arm = i % 4 < 2 && i / 4 >= 2;
+        c->z[i] = arm ? 0.3 : 0.0;
+        set_end(c, i, c->x[i] + (arm ? 2.0 : 0.0), c->y[i], arm ? -0.3 : 0.0);
+    }
+    clear_contacts(c);
+    int32_t before = count_ccd_collisions(c, 0.0);
+    wc_step_stats st;
+    memset(&st, 0, sizeof st);
+    wc_status s = wci_self_collide(c, 1.0 / 24, 1, &st);
+    CHECK(s == WC_OK, "self_collide: %d", (int)s);
+    int32_t after = count_ccd_collisions(c, 0.0);
+    printf("in-plane fold: colliding pairs in the motion before %d, after %d; cloth contacts %d, "
+           "fail-safe particles %d\n",
+           (int)before, (int)after, (int)st.cloth_contacts, (int)st.failsafe_particles);
+    CHECK(before > 0, "the arm's motion does not cross the other arm");
+    CHECK(after == 0, "the arm passes through the other: %d colliding pairs left", (int)after);
+    wc_world_destroy(w);
+}
+
 int main(void)
 {
     test_vertex_face();
@@ -641,5 +792,7 @@ int main(void)
     test_threads();
     test_fold();
     test_two_cloths();
+    test_contour();
+    test_in_plane_fold();
     return test_report("test_selfcollide");
 }
