@@ -223,6 +223,37 @@ static int compatible(const wc_contour_segment *s, const wc_contour_segment *t, 
     return stay_apart(s, t, 2.0 * margin);
 }
 
+/* Whether the boundary is star-shaped around a point c over the whole step:
+ * every segment turns the same way round c all along (the cross product of
+ * its ends relative to c, a quadratic in time, has Bernstein coefficients of
+ * one sign), and at the start the loop goes round c once (a ray from c
+ * crosses it once). Then the polar angle round c rises along every segment
+ * and by 2 pi in all: the loop is the graph of a radius over the angle,
+ * simple. A patch of cloth, two side by side or three in a row or an L,
+ * seen along its cone's axis is star-shaped round the mean of its boundary
+ * vertices unless it is crushed: O(segments), where the general test pairs
+ * segments up. The boundary runs counter-clockwise (its triangles face d). */
+static int star_shaped(const wc_contour_segment *segments, int32_t count)
+{
+    double c[2] = {0.0, 0.0};
+    for (int32_t k = 0; k < count; ++k) c[0] += segments[k].a0[0], c[1] += segments[k].a0[1];
+    c[0] /= count, c[1] /= count;
+    int32_t crossings = 0;
+    for (int32_t k = 0; k < count; ++k) {
+        const wc_contour_segment *s = segments + k;
+        double a0[2] = {s->a0[0] - c[0], s->a0[1] - c[1]}, b0[2] = {s->b0[0] - c[0], s->b0[1] - c[1]};
+        double a1[2] = {a0[0] + s->da[0], a0[1] + s->da[1]}, b1[2] = {b0[0] + s->db[0], b0[1] + s->db[1]};
+        double tol = ROUNDING * (dot2(a0, a0) + dot2(b0, b0) + dot2(a1, a1) + dot2(b1, b1));
+        double k0 = cross2(a0, b0), k1 = 0.5 * (cross2(a0, b1) + cross2(a1, b0)), k2 = cross2(a1, b1);
+        if (!(min2(k0, min2(k1, k2)) > tol)) return 0;
+        /* the ray from c along +x: with the segment turning counter-clockwise
+         * round c it can only cross upward, at x > 0 where a0 is below and
+         * b0 on or above the axis (half-open, so a vertex counts once) */
+        crossings += a0[1] < 0.0 && b0[1] >= 0.0;
+    }
+    return crossings == 1;
+}
+
 static int compare_segments(const void *pa, const void *pb)
 {
     const wc_contour_segment *p = pa, *q = pb;
@@ -234,9 +265,8 @@ int wci_contour_simple(wc_contour_segment *segments, int32_t count, const double
                        const double *x, const double *y, const double *z, const double *nx,
                        const double *ny, const double *nz, double scale)
 {
-    double e1[3], e2[3];
+    double e1[3], e2[3], drift[2] = {0.0, 0.0};
     plane_basis(d, e1, e2);
-    double largest = 0.0;
     for (int32_t k = 0; k < count; ++k) {
         wc_contour_segment *s = segments + k;
         int32_t a = s->from, b = s->to;
@@ -245,10 +275,22 @@ int wci_contour_simple(wc_contour_segment *segments, int32_t count, const double
         project(e1, e2, x[b], y[b], z[b], s->b0);
         project(e1, e2, nx[a], ny[a], nz[a], a1);
         project(e1, e2, nx[b], ny[b], nz[b], b1);
+        for (int m = 0; m < 2; ++m) s->da[m] = a1[m] - s->a0[m], s->db[m] = b1[m] - s->b0[m];
+        drift[0] += s->da[0], drift[1] += s->da[1];
+    }
+    /* Whether a curve is simple does not change when the whole plane moves:
+     * the tests below look at the motion relative to the boundary's mean
+     * one (every boundary vertex starts one segment), so a region falling or
+     * sliding as a whole moves by little, however fast it goes. */
+    drift[0] /= count, drift[1] /= count;
+    double largest = 0.0;
+    for (int32_t k = 0; k < count; ++k) {
+        wc_contour_segment *s = segments + k;
         for (int m = 0; m < 2; ++m) {
-            s->da[m] = a1[m] - s->a0[m], s->db[m] = b1[m] - s->b0[m];
-            s->box[m] = min2(min2(s->a0[m], a1[m]), min2(s->b0[m], b1[m]));
-            s->box[m + 2] = max2(max2(s->a0[m], a1[m]), max2(s->b0[m], b1[m]));
+            s->da[m] -= drift[m], s->db[m] -= drift[m];
+            double a1 = s->a0[m] + s->da[m], b1 = s->b0[m] + s->db[m];
+            s->box[m] = min2(min2(s->a0[m], a1), min2(s->b0[m], b1));
+            s->box[m + 2] = max2(max2(s->a0[m], a1), max2(s->b0[m], b1));
             largest = max2(largest, max2(fabs(s->box[m]), fabs(s->box[m + 2])));
         }
         s->reach = sqrt(max2(dot2(s->da, s->da), dot2(s->db, s->db)));
@@ -259,6 +301,7 @@ int wci_contour_simple(wc_contour_segment *segments, int32_t count, const double
     if (!(margin > 0.0) || !isfinite(margin)) return 0;
     for (int32_t k = 0; k < count; ++k)
         for (int m = 0; m < 2; ++m) segments[k].box[m] -= margin, segments[k].box[m + 2] += margin;
+    if (star_shaped(segments, count)) return 1;
     /* Only segments whose swept boxes overlap can meet. A few dozen
      * segments (a region of cloth patches) are cheaper to pair up directly
      * than to sort; more are swept along the first axis. The answer is the

@@ -53,7 +53,9 @@ typedef struct wc_contour_segment {
 /// along the unit vector d while every particle moves linearly from
 /// (x, y, z) to (nx, ny, nz): segments without a common end never meet, and
 /// two with one never fold onto each other. Conservative: 0 also when a test
-/// is too close to call. scale is a length of the region (its mean edge), for
+/// is too close to call. Looks at the motion relative to the boundary's mean
+/// motion, and first at whether the loop stays star-shaped round its centre
+/// (O(count)); only then pairs up segments whose swept boxes overlap. scale is a length of the region (its mean edge), for
 /// rounding margins. Fills the rest of each segment and reorders them.
 int wci_contour_simple(wc_contour_segment *segments, int32_t count, const double d[3],
                        const double *x, const double *y, const double *z, const double *nx,

@@ -280,6 +280,7 @@ static int grow_int32(int32_t **buf, int64_t *capacity, int64_t needed)
 }
 
 static int32_t max2i(int32_t a, int32_t b) { return a > b ? a : b; }
+static int32_t min2i(int32_t a, int32_t b) { return a < b ? a : b; }
 
 static int sorted_contains(const int32_t *list, int32_t count, int32_t item)
 {
@@ -397,14 +398,19 @@ static int build_edges(wc_self_state *s, const wc_cloth *c, int32_t *neighbours)
     return 1;
 }
 
-/* Bin of a triangle: its rest centroid's cube of side `cell`, as a key that
- * sorts the same on every platform. */
+/* Bin of a triangle: the cube of side `cell` holding the rest position of
+ * its lowest-index particle, as a key that sorts the same on every
+ * platform. By that particle rather than the centroid: the two triangles of
+ * a quad of a grid or quad mesh share it and fall in one bin, so the bins'
+ * walls run along quad edges, and patches are whole quads with boundaries
+ * that the contour check passes in one sweep round their centre (a wall
+ * between the two triangles of each quad would leave a saw-tooth edge). */
 static void triangle_bin(const wc_self_state *s, int32_t t, double cell, int64_t key[3])
 {
+    const int32_t *tri = s->triangles + 3 * (size_t)t;
+    int32_t lowest = min2i(tri[0], min2i(tri[1], tri[2]));
     for (int k = 0; k < 3; ++k) {
-        double m = 0.0;
-        for (int j = 0; j < 3; ++j) m += s->rest[3 * (size_t)s->triangles[3 * (size_t)t + j] + k];
-        double b = floor(m / 3.0 / cell);
+        double b = floor(s->rest[3 * (size_t)lowest + k] / cell);
         key[k] = b < -1e15 ? (int64_t)-1e15 : b > 1e15 ? (int64_t)1e15 : (int64_t)b;
     }
 }

@@ -741,11 +741,23 @@ static void test_contour(void)
     int32_t one_tri[3] = {0, 1, 2};
     n = boundary_of(one_tri, 1, seg);
     int folded = wci_contour_simple(seg, n, up, tx, ty, tz, ux, uy, uz, 1.0);
+    /* the U's base row (three quads, star-shaped round its centre) thrown
+     * 10 quads sideways in one step, and the same with a corner pulled
+     * across the opposite side */
+    int32_t base[18];
+    memcpy(base, tris, sizeof base);
+    for (int i = 0; i < U_PARTICLES; ++i) nx[i] = x[i] + 10.0, ny[i] = y[i], nz[i] = z[i];
+    n = boundary_of(base, 6, seg);
+    int thrown = wci_contour_simple(seg, n, up, x, y, z, nx, ny, nz, 1.0);
+    ny[4] = y[4] - 2.0; /* particle 4, the corner (0, 1), ends below the bottom side */
+    n = boundary_of(base, 6, seg);
+    int pulled = wci_contour_simple(seg, n, up, x, y, z, nx, ny, nz, 1.0);
     printf("contour: U shifted rigidly: simple %d; an arm slid over the other: %d; slid to a quarter "
-           "short: %d; a triangle turned over in its plane: %d\n",
-           still, slid, short_of, folded);
-    CHECK(still && short_of, "a boundary that stays simple is not taken for simple");
-    CHECK(!slid && !folded, "a boundary that crosses itself is taken for simple");
+           "short: %d; a triangle turned over in its plane: %d; a row of quads thrown 10 quads: %d, "
+           "with a corner pulled across: %d\n",
+           still, slid, short_of, folded, thrown, pulled);
+    CHECK(still && short_of && thrown, "a boundary that stays simple is not taken for simple");
+    CHECK(!slid && !folded && !pulled, "a boundary that crosses itself is taken for simple");
 }
 
 /* The U as a cloth (thickness 0.05, unit quads): arm 0's top two rows start
