@@ -25,6 +25,13 @@
  *      over the other arm and down through it in one step, every triangle
  *      facing up throughout, is stopped: the cone alone would skip the
  *      region's element tests.
+ *  (h) a layer knocked onto a collider's tip: a cloth of two 5 x 5 layers
+ *      over a thin pyramid, the lower one resting 2 mm above the contact
+ *      distance from its tip, the upper one thrown down onto it at 20 m/s;
+ *      the response between the layers pushes the lower one down over the
+ *      tip in the same step, and what it moved goes through the collider
+ *      stage again (world.c), so no step ends with the tip through the
+ *      cloth (without that second pass: 4 cloth-pyramid pairs).
  * (a)-(d), (g) drive wci_self_collide directly on a cloth's internal arrays, with
  * a brute-force check (every vertex-face and edge-edge pair, no broadphase)
  * of what remains. */
@@ -794,6 +801,75 @@ static void test_in_plane_fold(void)
     wc_world_destroy(w);
 }
 
+/* ------------------------------------------------------------------------ */
+/* (h) knocked onto a collider's tip                                        */
+/* ------------------------------------------------------------------------ */
+
+static void test_knocked_onto_tip(void)
+{
+    wc_world_def wd = wc_world_def_default();
+    wd.thread_count = 1;
+    wd.gravity[2] = 0.0;
+    wc_world *w = NULL;
+    wc_message m;
+    CHECK(wc_world_create(&wd, &w, &m) == WC_OK, "world: %s", m.text);
+    if (!w) return;
+    const double verts[15] = {0, 0, 0, -0.05, -0.05, -0.5, 0.05, -0.05, -0.5, 0.05, 0.05, -0.5,
+                              -0.05, 0.05, -0.5};
+    const int32_t tris[18] = {0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 1, 3, 2, 1, 4, 3};
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertices = verts, d.vertex_count = 5, d.triangles = tris, d.triangle_count = 6;
+    d.thickness = 0.0;
+    int32_t col;
+    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    /* two layers of 5 x 5 particles (0.2 m), the tip under the middle of a
+     * triangle of the lower one */
+    double xyz[3 * 50], vel[3 * 50];
+    int32_t faces[3 * 64], nf = 0;
+    const double h = 0.005, lower = h + 0.002, upper = lower + 0.02;
+    for (int layer = 0; layer < 2; ++layer)
+        for (int j = 0; j < 5; ++j)
+            for (int i = 0; i < 5; ++i) {
+                int k = 25 * layer + 5 * j + i;
+                xyz[3 * k] = -0.1 + 0.05 * i + 0.013, xyz[3 * k + 1] = -0.1 + 0.05 * j + 0.017;
+                xyz[3 * k + 2] = layer ? upper : lower;
+                vel[3 * k] = vel[3 * k + 1] = 0.0, vel[3 * k + 2] = layer ? -20.0 : 0.0;
+            }
+    for (int layer = 0; layer < 2; ++layer)
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) {
+                int32_t a = 25 * layer + 5 * j + i, q[6] = {a, a + 1, a + 6, a, a + 6, a + 5};
+                memcpy(faces + 3 * nf, q, sizeof q);
+                nf += 2;
+            }
+    wc_mesh_cloth_def md = wc_mesh_cloth_def_default();
+    md.vertices = xyz, md.vertex_count = 50, md.faces = faces, md.face_count = nf, md.face_size = 3;
+    md.material.thickness = h;
+    md.self_collision = 1;
+    int32_t cl;
+    CHECK(wc_world_add_mesh_cloth(w, &md, &cl) == WC_OK, "%s", wc_world_last_error(w));
+    CHECK(wc_cloth_set_velocities(w, cl, vel, 50) == WC_OK, "%s", wc_world_last_error(w));
+    int32_t worst_collider = 0, worst_cloth = 0;
+    double lowest = INFINITY;
+    for (int step = 0; step < 8; ++step) {
+        CHECK(wc_world_step(w, 1.0 / 240) == WC_OK, "step %d: %s", step, wc_world_last_error(w));
+        wc_intersection_counts k;
+        CHECK(wc_world_count_intersections(w, &k) == WC_OK, "%s", wc_world_last_error(w));
+        if (k.cloth_collider > worst_collider) worst_collider = k.cloth_collider;
+        if (k.cloth_cloth > worst_cloth) worst_cloth = k.cloth_cloth;
+        wc_cloth_get_positions(w, cl, xyz, 50);
+        for (int i = 0; i < 25; ++i) lowest = fmin(lowest, xyz[3 * i + 2]);
+    }
+    printf("knocked onto a tip: lower layer's lowest particle %.4f m (started %.4f above the tip); "
+           "worst intersections in a step: %d with the pyramid, %d between the layers\n",
+           lowest, lower, (int)worst_collider, (int)worst_cloth);
+    CHECK(lowest < 0.0, "the lower layer was not knocked down past the tip (lowest at %g m)", lowest);
+    CHECK(worst_collider == 0 && worst_cloth == 0,
+          "knocked onto a tip: %d cloth-pyramid and %d cloth-cloth intersections",
+          (int)worst_collider, (int)worst_cloth);
+    wc_world_destroy(w);
+}
+
 int main(void)
 {
     test_vertex_face();
@@ -806,5 +882,6 @@ int main(void)
     test_two_cloths();
     test_contour();
     test_in_plane_fold();
+    test_knocked_onto_tip();
     return test_report("test_selfcollide");
 }
