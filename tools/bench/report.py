@@ -400,6 +400,8 @@ def scaling(out, quick, lines):
     lines += ["## Scaling", "",
               "n x n cloth of link length 1/63 m resting on a ground plate (every particle in "
               f"contact, bench_collide's scene), {steps} steps at the stable step timed after 3, "
+              "with the world's default integrator (the implicit one: its stable step is longer "
+              "than Verlet's and costs more), "
               "best of 3 runs with 1 and 2 threads alternated, OpenMP threads waiting passively. "
               f"Load average before this section: {load()} (2 cores: the 2-thread figures are "
               "only meaningful on an idle machine).", "",
