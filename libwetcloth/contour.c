@@ -160,6 +160,17 @@ static double point_segment2(const double p[2], const double a[2], const double 
     return sqrt(dot2(d, d));
 }
 
+/* The cross product of two vectors moving linearly over the step, a0 -> a1
+ * and b0 -> b1, is the quadratic (1-t)^2 k0 + 2t(1-t) k1 + t^2 k2 (k1 the
+ * mean of the mixed terms) and stays between its Bernstein coefficients k;
+ * returns a rounding tolerance for them, relative to the vectors' sizes. */
+static double cross_bounds(const double a0[2], const double a1[2], const double b0[2],
+                           const double b1[2], double k[3])
+{
+    k[0] = cross2(a0, b0), k[1] = 0.5 * (cross2(a0, b1) + cross2(a1, b0)), k[2] = cross2(a1, b1);
+    return ROUNDING * (dot2(a0, a0) + dot2(b0, b0) + dot2(a1, a1) + dot2(b1, b1));
+}
+
 /* Distance between segments ab and cd: 0 when they cross, else the least
  * distance from an end to the other segment. A crossing that rounding hides
  * has an end within rounding of the other segment, so the distance found is
@@ -202,12 +213,11 @@ static void arm(const wc_contour_segment *s, int32_t v, double start[2], double 
  * the dot product, rules the fold out. */
 static int no_fold(const wc_contour_segment *s, const wc_contour_segment *t, int32_t v)
 {
-    double a0[2], a1[2], b0[2], b1[2];
+    double a0[2], a1[2], b0[2], b1[2], k[3];
     arm(s, v, a0, a1);
     arm(t, v, b0, b1);
-    double tol = ROUNDING * (dot2(a0, a0) + dot2(b0, b0) + dot2(a1, a1) + dot2(b1, b1));
-    double k0 = cross2(a0, b0), k1 = 0.5 * (cross2(a0, b1) + cross2(a1, b0)), k2 = cross2(a1, b1);
-    if (min2(k0, min2(k1, k2)) > tol || max2(k0, max2(k1, k2)) < -tol) return 1;
+    double tol = cross_bounds(a0, a1, b0, b1, k);
+    if (min2(k[0], min2(k[1], k[2])) > tol || max2(k[0], max2(k[1], k[2])) < -tol) return 1;
     double c0 = dot2(a0, b0), c1 = 0.5 * (dot2(a0, b1) + dot2(a1, b0)), c2 = dot2(a1, b1);
     return max2(c0, max2(c1, c2)) < -tol;
 }
@@ -243,9 +253,8 @@ static int star_shaped(const wc_contour_segment *segments, int32_t count)
         const wc_contour_segment *s = segments + k;
         double a0[2] = {s->a0[0] - c[0], s->a0[1] - c[1]}, b0[2] = {s->b0[0] - c[0], s->b0[1] - c[1]};
         double a1[2] = {a0[0] + s->da[0], a0[1] + s->da[1]}, b1[2] = {b0[0] + s->db[0], b0[1] + s->db[1]};
-        double tol = ROUNDING * (dot2(a0, a0) + dot2(b0, b0) + dot2(a1, a1) + dot2(b1, b1));
-        double k0 = cross2(a0, b0), k1 = 0.5 * (cross2(a0, b1) + cross2(a1, b0)), k2 = cross2(a1, b1);
-        if (!(min2(k0, min2(k1, k2)) > tol)) return 0;
+        double k[3], tol = cross_bounds(a0, a1, b0, b1, k);
+        if (!(min2(k[0], min2(k[1], k[2])) > tol)) return 0;
         /* the ray from c along +x: with the segment turning counter-clockwise
          * round c it can only cross upward, at x > 0 where a0 is below and
          * b0 on or above the axis (half-open, so a vertex counts once) */
@@ -265,6 +274,7 @@ int wci_contour_simple(wc_contour_segment *segments, int32_t count, const double
                        const double *x, const double *y, const double *z, const double *nx,
                        const double *ny, const double *nz, double scale)
 {
+    if (count < 3) return 0; /* no loop */
     double e1[3], e2[3], drift[2] = {0.0, 0.0};
     plane_basis(d, e1, e2);
     for (int32_t k = 0; k < count; ++k) {

@@ -435,13 +435,12 @@ static int32_t group_of(int32_t *root, int32_t p)
 }
 
 /* Patches of fewer than PATCH_MIN triangles are pieces of a bin that its
- * walls cut off: along a grid cloth's border, where the walls run between
- * the two triangles of each quad, single triangles. Each is merged, in patch
- * order, into the smallest patch across one of its edges that has room
- * (lowest index on a tie), so every patch stays connected; fewer patches
- * mean fewer pairs of them and shorter boundaries in all (20 x 20 cloth: 98
- * patches, 58 of them single triangles, before). Renumbers triangle_patch;
- * returns the new count, or -1 on out-of-memory. */
+ * walls cut off (along a cloth's border, a strip one quad wide). Each is
+ * merged, in patch order, into the smallest patch across one of its edges
+ * that has room (lowest index on a tie), so every patch stays connected;
+ * fewer patches mean fewer pairs of them to check and shorter boundaries in
+ * all. Renumbers triangle_patch; returns the new count, or -1 on
+ * out-of-memory. */
 static int32_t merge_small_patches(wc_self_state *s, const int32_t *neighbours, int32_t patches)
 {
     int32_t nt = s->triangle_count;
@@ -761,7 +760,8 @@ wc_self_state *wci_self_state_create_pieces(const wc_cloth *c, const wc_self_pie
     int slices_ok = 1;
     for (int k = 0; k < SLICES; ++k)
         slices_ok = slices_ok && (s->slices[k].contour = wci_alloc_array(region_most, sizeof *s->contour));
-    if (!slices_ok || !s->contour || !s->particle_boxes || !s->triangle_boxes || !s->edge_boxes || !s->triangle_normals ||
+    if (!slices_ok || !s->contour || !s->particle_boxes || !s->triangle_boxes || !s->edge_boxes ||
+        !s->triangle_normals ||
         !s->patch_boxes || !s->patch_grown || !s->patch_axis || !s->patch_cos || !s->patch_fit ||
         !s->patch_culled || !s->patch_touched || !s->adjacent_culled || !s->dirty || !s->reverted || !s->moved ||
         !s->rest_triangle_boxes || !s->rest_edge_boxes) {
@@ -1618,6 +1618,14 @@ static void pair_friction(const wc_cloth *c, const wc_self_state *s, const self_
     }
 }
 
+/* A particle moved by a response or the fail-safe: its pairs are evaluated
+ * again, and the collider stage looks at it again (wci_self_state_moved). */
+static void note_moved(wc_self_state *s, int32_t i)
+{
+    s->dirty[i] = 1;
+    if (!s->moved[i]) s->moved[i] = 1, ++s->moved_count;
+}
+
 /* Answers one contact against the current state through the one response
  * (response.h): an inelastic impulse that removes the approach along n, a
  * position correction to the pair's target separation, Coulomb and wet
@@ -1627,12 +1635,6 @@ static void pair_friction(const wc_cloth *c, const wc_self_state *s, const self_
  * h (elements that start touching are parted a little, or the continuous
  * test would find them again); a proximity's target is h. Returns whether
  * any particle moved. */
-static void note_moved(wc_self_state *s, int32_t i)
-{
-    s->dirty[i] = 1;
-    if (!s->moved[i]) s->moved[i] = 1, ++s->moved_count;
-}
-
 static int respond(wc_cloth *c, wc_self_state *s, const self_contact *k, const double friction[2],
                    double slack, int32_t *marked)
 {
@@ -1743,6 +1745,17 @@ static int still_valid(wc_self_state *s, const wc_cloth *c, int threads)
     return 1;
 }
 
+/* A new broadphase for the current motion; every pair is to be evaluated. */
+static wc_status rebuild_candidates(wc_self_state *s, const wc_cloth *c, const self_ctx *ctx,
+                                    double g, int threads)
+{
+    s->built = 0;
+    if (broadphase(s, c, ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+    s->built = 1, s->built_h = ctx->h;
+    memset(s->dirty, 1, (size_t)s->particle_count);
+    return WC_OK;
+}
+
 /* Puts a particle back where the step started, at rest. */
 static void revert(wc_cloth *c, wc_self_state *s, int32_t i)
 {
@@ -1785,12 +1798,8 @@ static wc_status failsafe(wc_cloth *c, wc_self_state *s, self_ctx *ctx, double g
         }
         if (!newly) break;
         total += newly;
-        if (!still_valid(s, c, threads)) {
-            s->built = 0;
-            if (broadphase(s, c, ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
-            s->built = 1;
-            memset(s->dirty, 1, (size_t)s->particle_count);
-        }
+        if (!still_valid(s, c, threads) && rebuild_candidates(s, c, ctx, g, threads))
+            return WC_ERROR_OUT_OF_MEMORY;
         evaluate(s, ctx, 1, threads);
     }
     *count = total;
@@ -1845,13 +1854,15 @@ wc_status wci_self_verify(wc_cloth *c, const uint8_t *moved, int threads, wc_ste
     if (threads < 1) threads = 1;
     self_ctx ctx = context_of(c);
     double g = BOX_MARGIN * ctx.h;
-    memset(s->dirty, 0, (size_t)s->particle_count);
-    for (int32_t i = 0; i < s->particle_count; ++i) s->dirty[i] = moved[i];
+    memcpy(s->dirty, moved, (size_t)s->particle_count);
     if (!(s->built && s->built_h == ctx.h) || !still_valid(s, c, threads)) {
-        s->built = 0;
-        if (broadphase(s, c, &ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
-        s->built = 1, s->built_h = ctx.h;
-        memset(s->dirty, 1, (size_t)s->particle_count);
+        if (rebuild_candidates(s, c, &ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
+    } else {
+        /* a pair that still collides from wci_self_collide and that nothing
+         * moved since has had its free particles put back already: only the
+         * moved particles' pairs are the fail-safe's now */
+        if (s->vf_count) memset(s->vf_status, 0, (size_t)s->vf_count);
+        if (s->ee_count) memset(s->ee_status, 0, (size_t)s->ee_count);
     }
     evaluate(s, &ctx, 1, threads);
     int32_t reverted = 0;
@@ -1886,12 +1897,7 @@ wc_status wci_self_collide(wc_cloth *c, double dt, int threads, wc_step_stats *s
         }
     }
     for (int pass = 0;; ++pass) {
-        if (rebuild) {
-            s->built = 0;
-            if (broadphase(s, c, &ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
-            s->built = 1, s->built_h = ctx.h;
-            memset(s->dirty, 1, (size_t)s->particle_count);
-        }
+        if (rebuild && rebuild_candidates(s, c, &ctx, g, threads)) return WC_ERROR_OUT_OF_MEMORY;
         int last = pass >= SELF_PASSES;
         evaluate(s, &ctx, last, threads);
         if (last || !respond_all(c, s, &ctx, pass, &marked)) break;

@@ -205,10 +205,6 @@ static wc_status guard_steps(wc_world *w, double dt, int threads)
     return WC_OK;
 }
 
-/* Colliders move to where they are at the end of this step; each contact
- * then answers to the relative motion. `share` is the part of what is left
- * of the advance that this step covers, `steps_left` how many steps of it
- * follow this one. */
 /* What self-collision or the collision between cloths moved may now lie
  * against a collider feature the collider stage saw clear (a triangle pushed
  * down onto a proud vertex), so the collider stage runs again over it; what
@@ -239,6 +235,10 @@ static wc_status between_cloths_failed(wc_world *w)
                    "state");
 }
 
+/* Colliders move to where they are at the end of this step; each contact
+ * then answers to the relative motion. `share` is the part of what is left
+ * of the advance that this step covers, `steps_left` how many steps of it
+ * follow this one. */
 static wc_status collide(wc_world *w, const step_context *ctx)
 {
     double dt = ctx->dt;
