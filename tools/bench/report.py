@@ -186,11 +186,12 @@ def speed_vs_error(out, quick, lines):
             for sub in sweep:
                 pos, cost, used, err = run_scene(make, n, integ, sub, frames)
                 # Verlet's automatic setting is passed as its count (auto)
-                default = integ == DEFAULT_INTEGRATOR and sub == (auto if integ == "verlet" else 0)
+                automatic = sub == (auto if integ == "verlet" else 0)
+                default = integ == DEFAULT_INTEGRATOR and automatic
                 if default:
                     default_pos = pos
                 row = {"integrator": integ, "substeps": used if sub == 0 else sub,
-                       "automatic": sub == 0 or default, "default": default,
+                       "automatic": automatic, "default": default,
                        "step": scenes.FRAME / (used if sub == 0 else sub)}
                 if err:
                     row.update(error=None, cost=None, failed=err)
@@ -696,11 +697,13 @@ def main():
     # (quick only: in 6 frames the drapes have not reached the sphere; with
     # contact, the full runs' errors are measured, not bounded)
     for name, r in ((results.get("speed_vs_error") or {}) if a.quick else {}).items():
-        if name in scenes.CONTROLS:  # Verlet only: the default setting is not run
-            continue
-        d = [row for row in r["rows"] if row["default"]]
+        # Verlet's automatic setting against the same integrator at 8x its
+        # steps: before contact that is the step's error alone. (The other
+        # integrators' distance to that reference also holds their model's
+        # difference, measured, not bounded.)
+        d = [row for row in r["rows"] if row["integrator"] == "verlet" and row["automatic"]]
         if not d or d[0]["failed"] or not d[0]["error"] <= 1e-3:
-            failures.append(f"{name}: the default setting's error is not below 1e-3: {d}")
+            failures.append(f"{name}: Verlet's automatic setting's error is not below 1e-3: {d}")
     if results.get("hard_cases_exit_code"):
         failures.append("test_hard_cases failed")
     for row in results.get("blender") or []:
