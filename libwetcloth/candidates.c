@@ -36,7 +36,7 @@ static void lists_free(wc_pair_lists *l)
 
 void wci_candidates_destroy(wc_candidates *c)
 {
-    wci_free(c->base), wci_free(c->margin), wci_free(c->base_path), wci_free(c->base_length);
+    wci_free(c->base), wci_free(c->margin), wci_free(c->base_path);
     lists_free(&c->particles), lists_free(&c->triangles), lists_free(&c->edges);
     wci_free(c->vertex_seen), wci_free(c->edge_seen), wci_free(c->found), wci_free(c->gathered), wci_free(c->gathered_d0);
     memset(c, 0, sizeof *c);
@@ -53,7 +53,7 @@ static int lists_init(wc_pair_lists *l, int32_t owners, int per)
     l->room = wci_alloc_array(n, sizeof *l->room);
     l->path_at = wci_alloc_array(n, sizeof *l->path_at);
     l->least = wci_alloc_array(n, sizeof *l->least);
-    l->snap = wci_alloc_array(n * (size_t)(per > 0 ? per : 1), sizeof *l->snap);
+    l->snap = wci_alloc_array(3 * n * (size_t)(per > 0 ? per : 1), sizeof *l->snap);
     return l->start && l->count && l->room && l->path_at && l->least && l->snap;
 }
 
@@ -84,8 +84,8 @@ static int lists_repack(wc_pair_lists *l, int64_t capacity)
 }
 
 /* Owner k's list becomes items/d0[0 .. n) (sorted by the caller), its
- * snapshot the collider's path and the owner's particles' path lengths at
- * their bases. */
+ * snapshot the collider's path and the owner's particles' bases (`snap`,
+ * xyz per particle). */
 static int lists_put(wc_pair_lists *l, int32_t k, const int32_t *items, const double *d0, int32_t n,
                      double path, const double *snap)
 {
@@ -94,7 +94,7 @@ static int lists_put(wc_pair_lists *l, int32_t k, const int32_t *items, const do
     for (int32_t j = 0; j < n; ++j)
         if (d0[j] < least) least = d0[j];
     l->least[k] = least;
-    for (int j = 0; j < l->per; ++j) l->snap[(size_t)l->per * (size_t)k + (size_t)j] = snap[j];
+    memcpy(l->snap + 3 * (size_t)l->per * (size_t)k, snap, 3 * (size_t)l->per * sizeof *snap);
     if (n > l->room[k]) {
         l->garbage += l->room[k];
         l->room[k] = 0, l->count[k] = 0;
@@ -266,7 +266,7 @@ static int particle_list(wc_candidates *c, scratch *s, const wc_collider *col, c
         double d = wci_candidates_particle_distance(col, c->found[k], p);
         if (d <= reach) e[kept].d0 = d, e[kept].item = c->found[k], ++kept;
     }
-    return keep_sorted(c, &c->particles, i, e, kept, c->base_path[i], c->base_length + i);
+    return keep_sorted(c, &c->particles, i, e, kept, c->base_path[i], p);
 }
 
 /* Cloth triangle t's list: collider vertices within r + M of it (its
@@ -295,7 +295,8 @@ static int triangle_list(wc_candidates *c, scratch *s, const wc_cloth_elements *
             if (dist <= reach) e[kept].d0 = dist, e[kept].item = v, ++kept;
         }
     for (int32_t k = 0; k < seen; ++k) c->vertex_seen[c->gathered[k]] = 0;
-    double snap[3] = {c->base_length[idx[0]], c->base_length[idx[1]], c->base_length[idx[2]]};
+    double snap[9];
+    memcpy(snap, a, sizeof a), memcpy(snap + 3, b, sizeof b), memcpy(snap + 6, d, sizeof d);
     return keep_sorted(c, &c->triangles, t, e, kept, path, snap);
 }
 
@@ -351,7 +352,8 @@ static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, 
             if (dist <= reach) e[kept].d0 = dist, e[kept].item = f, ++kept;
         }
     for (int32_t k = 0; k < seen; ++k) c->edge_seen[c->gathered[k]] = 0;
-    double snap[2] = {c->base_length[idx[0]], c->base_length[idx[1]]};
+    double snap[6];
+    memcpy(snap, a, sizeof a), memcpy(snap + 3, b, sizeof b);
     return keep_sorted(c, &c->edges, edge, e, kept, path, snap);
 }
 
@@ -364,18 +366,8 @@ static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, 
  * their queries sweep much of it (measured: the soaked 2 m cloth falling
  * past the sphere spent most of its step making lists); a rebase far from
  * everything costs a query that stops at the tree's root. */
-double wci_candidates_displacement(const wc_candidates *c, const wc_particle_arrays *p, int32_t i)
-{
-    const double *b = c->base + 3 * (size_t)i;
-    double s[3] = {p->x[i] - b[0], p->y[i] - b[1], p->z[i] - b[2]};
-    double e[3] = {p->nx[i] - b[0], p->ny[i] - b[1], p->nz[i] - b[2]};
-    double s2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2], e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-    return sqrt(s2 > e2 ? s2 : e2);
-}
-
 static void rebase_one(wc_candidates *c, const wc_collider *col, int32_t i,
-                       const wc_particle_arrays *pa, const wc_particle_paths *paths,
-                       int32_t steps_left)
+                       const wc_particle_arrays *pa, int32_t steps_left)
 {
     double p[3] = {pa->x[i], pa->y[i], pa->z[i]}, r = c->r;
     double d[3] = {pa->nx[i] - p[0], pa->ny[i] - p[1], pa->nz[i] - p[2]};
@@ -391,7 +383,6 @@ static void rebase_one(wc_candidates *c, const wc_collider *col, int32_t i,
     c->base[3 * (size_t)i] = p[0], c->base[3 * (size_t)i + 1] = p[1], c->base[3 * (size_t)i + 2] = p[2];
     c->margin[i] = m;
     c->base_path[i] = col->path;
-    c->base_length[i] = paths->path_start[i];
 }
 
 static int allocate(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col)
@@ -401,15 +392,13 @@ static int allocate(wc_candidates *c, const wc_cloth_elements *el, const wc_coll
     if (!c->base) c->base = wci_alloc_array(3 * n, sizeof *c->base);
     if (!c->margin) c->margin = wci_alloc_array(n, sizeof *c->margin);
     if (!c->base_path) c->base_path = wci_alloc_array(n, sizeof *c->base_path);
-    if (!c->base_length) c->base_length = wci_alloc_array(n, sizeof *c->base_length);
     if (!c->vertex_seen) c->vertex_seen = wci_alloc_array((size_t)col->vertex_count, 1);
     if (!c->edge_seen) c->edge_seen = wci_alloc_array((size_t)col->edge_count + 1, 1);
-    return c->base && c->margin && c->base_path && c->base_length && c->vertex_seen && c->edge_seen;
+    return c->base && c->margin && c->base_path && c->vertex_seen && c->edge_seen;
 }
 
 wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
-                              double r, const wc_particle_arrays *p, const wc_particle_paths *paths,
-                              int32_t steps_left)
+                              double r, const wc_particle_arrays *p, int32_t steps_left)
 {
     const wc_bvh *bvh = &col->bvh;
     if (!allocate(c, el, col) || !lists_init(&c->particles, el->particle_count, 1) ||
@@ -418,7 +407,7 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
     c->r = r;
     scratch s = {NULL, 0};
     int ok = 1;
-    for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, i, p, paths, steps_left);
+    for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, i, p, steps_left);
     for (int32_t i = 0; i < el->particle_count && ok; ++i) ok = particle_list(c, &s, col, bvh, i);
     for (int32_t t = 0; t < el->triangle_count && ok; ++t) ok = triangle_list(c, &s, el, col, bvh, t, col->path);
     for (int32_t e = 0; e < el->edge_count && ok; ++e) ok = edge_list(c, &s, el, col, bvh, e, col->path);
@@ -432,12 +421,12 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
 
 wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
                                const int32_t *particles, int32_t count, const wc_particle_arrays *p,
-                               const wc_particle_paths *paths, int32_t steps_left, uint8_t *mark)
+                               int32_t steps_left, uint8_t *mark)
 {
     const wc_bvh *bvh = &col->bvh;
     scratch s = {NULL, 0};
     int ok = 1;
-    for (int32_t k = 0; k < count; ++k) rebase_one(c, col, particles[k], p, paths, steps_left);
+    for (int32_t k = 0; k < count; ++k) rebase_one(c, col, particles[k], p, steps_left);
     for (int32_t k = 0; k < count && ok; ++k) ok = particle_list(c, &s, col, bvh, particles[k]);
     /* each triangle and edge of a rebased particle once, in the order met */
     for (int kind = 0; kind < 2 && ok; ++kind) {
@@ -462,24 +451,50 @@ wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, c
     return WC_OK;
 }
 
-double wci_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
-                           const wc_particle_paths *paths)
+/* The larger distance of particle i at the start and at the end of the
+ * step from a point: by convexity, the most it is from it over the step. */
+static double farthest_over_step(const wc_particle_arrays *p, int32_t i, const double at[3])
 {
-    const double *snap = l->snap + (size_t)l->per * (size_t)k;
+    double s[3] = {p->x[i] - at[0], p->y[i] - at[1], p->z[i] - at[2]};
+    double e[3] = {p->nx[i] - at[0], p->ny[i] - at[1], p->nz[i] - at[2]};
+    double s2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2], e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+    return sqrt(s2 > e2 ? s2 : e2);
+}
+
+double wci_candidates_displacement(const wc_candidates *c, const wc_particle_arrays *p, int32_t i)
+{
+    return farthest_over_step(p, i, c->base + 3 * (size_t)i);
+}
+
+double wci_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
+                           const wc_particle_arrays *p)
+{
+    const double *snap = l->snap + 3 * (size_t)l->per * (size_t)k;
     double most = 0.0;
     for (int j = 0; j < l->per; ++j) {
-        int32_t i = particles[j];
-        /* the end lies on the path after the snapshot; the start after it
-         * too when the snapshot is from an earlier step, else before it */
-        double ahead = paths->path[i] - snap[j], behind = snap[j] - paths->path_start[i];
-        double d = ahead > behind ? ahead : behind;
+        double d = farthest_over_step(p, particles[j], snap + 3 * j);
         if (d > most) most = d;
     }
     return most;
 }
 
+double wci_pair_lists_end_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
+                               const wc_particle_arrays *p)
+{
+    const double *snap = l->snap + 3 * (size_t)l->per * (size_t)k;
+    double most2 = 0.0;
+    for (int j = 0; j < l->per; ++j) {
+        int32_t i = particles[j];
+        const double *at = snap + 3 * j;
+        double e[3] = {p->nx[i] - at[0], p->ny[i] - at[1], p->nz[i] - at[2]};
+        double e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        if (e2 > most2) most2 = e2;
+    }
+    return sqrt(most2);
+}
+
 void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
-                         const wc_particle_paths *paths, double collider_path,
+                         const wc_particle_arrays *p, double collider_path,
                          const uint8_t *tested, const double *measured, double drift_end)
 {
     double least = INFINITY;
@@ -490,6 +505,9 @@ void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
     }
     l->least[k] = least;
     l->path_at[k] = collider_path;
-    double *snap = l->snap + (size_t)l->per * (size_t)k;
-    for (int j = 0; j < l->per; ++j) snap[j] = paths->path[particles[j]];
+    double *snap = l->snap + 3 * (size_t)l->per * (size_t)k;
+    for (int j = 0; j < l->per; ++j) {
+        int32_t i = particles[j];
+        snap[3 * j] = p->nx[i], snap[3 * j + 1] = p->ny[i], snap[3 * j + 2] = p->nz[i];
+    }
 }

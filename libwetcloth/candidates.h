@@ -56,39 +56,36 @@
 /// measures the distance of the pairs it tests anyway, so after a visit that
 /// pushed nothing it renews the owner's snapshot to the particles' present
 /// ends: tested pairs get the distance just measured, the others their old
-/// bound less how far the owner has moved since. A resting cloth then keeps
-/// bounds a rounding error below the truth, and its pairs at the contact
-/// distance are skipped until they sink by the contact's slack (1 % of r),
-/// instead of being tested at every step. How far an owner has moved since
-/// its snapshot is read from its particles' path lengths (the distance its
-/// end of step has travelled, which no displacement exceeds), noted per
-/// particle of the owner (`per` of them) when the snapshot was taken.
+/// bound less how far the owner has moved since. How far an owner has moved
+/// since its snapshot is the largest distance of its particles, at the
+/// start and at the end of the step, from where they were at the snapshot
+/// (kept per particle of the owner, `per` of them, xyz): the argument above
+/// with the snapshot for the base. A displacement, not the length of the
+/// path travelled: a particle resting on a collider sags under gravity and
+/// is pushed back at every step, so its path grows by twice the sag per
+/// step while it stays where it was. Resting pairs at the contact distance
+/// are then skipped until the cloth has moved by the contact's slack (1 %
+/// of r) from their snapshot, instead of being tested at every step once
+/// the sag exceeds the slack.
 typedef struct wc_pair_lists {
     int32_t owner_count;
     int per;
     int32_t *start, *count, *room;
     /// Per owner: the collider's path at its snapshot, the least d of its
-    /// items, and `per` particle path lengths.
+    /// items, and where its `per` particles were (xyz each).
     double *path_at, *least, *snap;
     int32_t *item;
     double *d;
     int64_t used, capacity, garbage;
 } wc_pair_lists;
 
-/// Per particle, kept by the stage that uses the lists (collider_contacts.c):
-/// the length of the path its end of step has travelled (its start of step
-/// lies on it too, at path_start), over the whole run.
-typedef struct wc_particle_paths {
-    const double *path, *path_start;
-} wc_particle_paths;
-
 /// One cloth against one mesh collider.
 typedef struct wc_candidates {
     /// Contact distance the lists were made for; 0 until made.
     double r;
-    /// Per particle: base position (xyz), margin, the collider's path and
-    /// its own path length at its last rebase.
-    double *base, *margin, *base_path, *base_length;
+    /// Per particle: base position (xyz), margin, and the collider's path
+    /// at its last rebase.
+    double *base, *margin, *base_path;
     wc_pair_lists particles, triangles, edges;
     /// Scratch: collider vertices and edges already gathered for one owner.
     uint8_t *vertex_seen, *edge_seen;
@@ -139,7 +136,7 @@ double wci_candidates_displacement(const wc_candidates *cand, const wc_particle_
 /// WC_ERROR_OUT_OF_MEMORY on failure.
 wc_status wci_candidates_update(wc_candidates *cand, const wc_cloth_elements *el,
                               const wc_collider *col, double r, const wc_particle_arrays *p,
-                              const wc_particle_paths *paths, int32_t steps_left);
+                              int32_t steps_left);
 
 /// Rebases the `count` particles listed (new base at their start-of-step
 /// position and a new margin) and makes their lists and those of their
@@ -147,13 +144,17 @@ wc_status wci_candidates_update(wc_candidates *cand, const wc_cloth_elements *el
 /// zero), sized for the larger of the cloth's triangle and edge counts.
 wc_status wci_candidates_rebase(wc_candidates *cand, const wc_cloth_elements *el,
                                const wc_collider *col, const int32_t *particles, int32_t count,
-                               const wc_particle_arrays *p, const wc_particle_paths *paths,
-                               int32_t steps_left, uint8_t *mark);
+                               const wc_particle_arrays *p, int32_t steps_left, uint8_t *mark);
 
 /// How far owner k's particles can be from where they were at its
 /// snapshot, over the step (starts and ends).
 double wci_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
-                           const wc_particle_paths *paths);
+                           const wc_particle_arrays *p);
+
+/// How far owner k's particles' ends are from where they were at its
+/// snapshot.
+double wci_pair_lists_end_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
+                               const wc_particle_arrays *p);
 
 /// After a visit of owner k that moved nothing: its snapshot renewed at its
 /// particles' present ends and the collider's end of step. tested[j] says
@@ -161,7 +162,7 @@ double wci_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *pa
 /// their bound less `drift_end` (how far owner and collider can have moved
 /// from the old snapshot to now).
 void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
-                         const wc_particle_paths *paths, double collider_path,
+                         const wc_particle_arrays *p, double collider_path,
                          const uint8_t *tested, const double *measured, double drift_end);
 
 /// Distance from a point to a collider triangle, vertex and edge in the

@@ -64,53 +64,22 @@ struct wc_collider_contacts {
     uint8_t *tested;
     double *measured;
     int32_t tested_capacity;
-    /// Per particle: the length of the path its end of step has travelled
-    /// (over the whole run), that length at the start of the step, where
-    /// the end was when last tracked, and its motion over the step.
-    double *path, *path_start, *last_end, *motion;
-    int tracked;
+    /// Per particle: its motion over the step (start to end, as it is).
+    double *motion;
 };
 
 /* ------------------------------------------------------------------------ */
-/* Paths (candidates.h, snapshots)                                          */
+/* Motion                                                                   */
 /* ------------------------------------------------------------------------ */
 
-/* Particle i's path goes on to its end of step as it is now. Touches only
- * particle i's entries (safe in the parallel particle pass). */
+/* Particle i's end of step has moved: its motion over the step noted, and
+ * the change for wci_collider_contacts_recheck. Touches only particle i's
+ * entries (safe in the parallel particle pass). */
 static void track(wc_collider_contacts *s, const wc_particle_arrays *p, int32_t i)
 {
-    double *last = s->last_end + 3 * (size_t)i;
-    double d[3] = {p->nx[i] - last[0], p->ny[i] - last[1], p->nz[i] - last[2]};
-    double step2 = dot3(d, d);
-    if (step2 > 0.0) s->path[i] += sqrt(step2);
-    last[0] = p->nx[i], last[1] = p->ny[i], last[2] = p->nz[i];
     double u[3] = {p->nx[i] - p->x[i], p->ny[i] - p->y[i], p->nz[i] - p->z[i]};
     s->motion[i] = sqrt(dot3(u, u));
     s->changed[i] = 1;
-}
-
-/* At the start of the stage: each path goes on to the start of the step
- * (where the end was committed, after whatever moved it since it was last
- * tracked: self-collision, the wet hold), which is noted, then to its end. */
-static void begin_paths(wc_collider_contacts *s, const wc_particle_arrays *p)
-{
-    for (int32_t i = 0; i < p->count; ++i) {
-        double *last = s->last_end + 3 * (size_t)i;
-        if (!s->tracked) last[0] = p->x[i], last[1] = p->y[i], last[2] = p->z[i];
-        double d[3] = {p->x[i] - last[0], p->y[i] - last[1], p->z[i] - last[2]};
-        double step2 = dot3(d, d);
-        if (step2 > 0.0) s->path[i] += sqrt(step2);
-        s->path_start[i] = s->path[i];
-        last[0] = p->x[i], last[1] = p->y[i], last[2] = p->z[i];
-        track(s, p, i);
-    }
-    s->tracked = 1;
-}
-
-static wc_particle_paths paths_of(const wc_collider_contacts *s)
-{
-    wc_particle_paths paths = {s->path, s->path_start};
-    return paths;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -202,11 +171,8 @@ wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *c)
     s->rebase_flag = wci_alloc_array(n, 1);
     s->visit_mark = wci_alloc_array(most, 1);
     s->visit_list = wci_alloc_array(most, sizeof *s->visit_list);
-    s->path = wci_alloc_array(n, sizeof *s->path);
-    s->path_start = wci_alloc_array(n, sizeof *s->path_start);
-    s->last_end = wci_alloc_array(3 * n, sizeof *s->last_end);
     s->motion = wci_alloc_array(n, sizeof *s->motion);
-    if (!ok || !s->path || !s->path_start || !s->last_end || !s->motion || !s->recheck || !s->changed || !s->shifted || !s->carry || !s->moved || !s->moving ||
+    if (!ok || !s->motion || !s->recheck || !s->changed || !s->shifted || !s->carry || !s->moved || !s->moving ||
         !s->moved_list || !s->moving_list || !s->rebase_list || !s->rebase_flag ||
         !s->visit_mark || !s->visit_list) {
         wci_collider_contacts_destroy(s);
@@ -223,7 +189,7 @@ void wci_collider_contacts_destroy(wc_collider_contacts *s)
                       s->el.edges_start, s->el.edges_of, s->recheck, s->changed, s->shifted, s->carry,
                       s->moved, s->moving, s->moved_list, s->moving_list, s->rebase_list,
                       s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->tested, s->measured,
-                      s->path, s->path_start, s->last_end, s->motion};
+                      s->motion};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wci_free(blocks[k]);
     wci_free(s);
 }
@@ -271,10 +237,9 @@ static wc_status flush_rebase(wc_collider_contacts *s, const wc_collider *col, i
                               const wc_particle_arrays *p, int32_t steps_left)
 {
     wc_status st = WC_OK;
-    wc_particle_paths paths = paths_of(s);
     if (s->rebase_count)
         st = wci_candidates_rebase(&s->cand[k], &s->el, col, s->rebase_list, s->rebase_count, p,
-                                  &paths, steps_left, s->visit_mark);
+                                  steps_left, s->visit_mark);
     for (int32_t j = 0; j < s->rebase_count; ++j) s->rebase_flag[s->rebase_list[j]] = 0;
     s->rebase_count = 0;
     return st;
@@ -294,8 +259,7 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         wc_candidates *cand = &s->cand[k];
         double r = contact_distance(c, col);
         if (cand->r != r) {
-            wc_particle_paths paths = paths_of(s);
-            if (wci_candidates_update(cand, &s->el, col, r, p, &paths, steps_left))
+            if (wci_candidates_update(cand, &s->el, col, r, p, steps_left))
                 return WC_ERROR_OUT_OF_MEMORY;
             continue;
         }
@@ -539,7 +503,7 @@ static double feature_motion(const wc_collider *col, const element_kind *kind, i
 }
 
 /* Notes what a push moved: for the next pass, for the particle pass, what
- * the fail-safe would carry it along by, and its path; a particle pushed
+ * the fail-safe would carry it along by, and its motion; a particle pushed
  * out of its cover against any collider is rebased there at once, so every
  * list stays whole. */
 static wc_status note_pushed(wc_collider_contacts *s, const wc_particle_arrays *p,
@@ -602,9 +566,8 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
     const wc_collider *col = colliders[k];
     const int32_t *idx = kind->particles + (size_t)kind->count * (size_t)e;
     const wc_pair_lists *l = kind->lists;
-    wc_particle_paths paths = paths_of(s);
     double reach = feature_reach(r) + FILTER_EPSILON(r);
-    double drift = wci_pair_lists_drift(l, e, idx, &paths) + collider_drift(col, l->path_at[e]);
+    double drift = wci_pair_lists_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
     /* nothing in the list can touch: the cheap way out of most visits */
     if (!s->use_filter ? l->count[e] == 0 : l->least[e] - drift > reach) return 0;
     double mu = sqrt(c->material.friction * col->friction);
@@ -641,16 +604,12 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
         if (hit < 0) break;
         pushed = 1, after = hit;
         /* the push moved the element (and perhaps rebased its list) */
-        drift = wci_pair_lists_drift(l, e, idx, &paths) + collider_drift(col, l->path_at[e]);
+        drift = wci_pair_lists_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
     }
     if (!pushed) {
         /* measured at the ends as they are: a fresh snapshot */
-        double end_drift = 0.0;
-        const double *snap = l->snap + (size_t)l->per * (size_t)e;
-        for (int j = 0; j < kind->count; ++j)
-            if (s->path[idx[j]] - snap[j] > end_drift) end_drift = s->path[idx[j]] - snap[j];
-        end_drift += collider_drift(col, l->path_at[e]);
-        wci_pair_lists_renew((wc_pair_lists *)l, e, idx, &paths, col->path + col->step_motion,
+        double end_drift = wci_pair_lists_end_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
+        wci_pair_lists_renew((wc_pair_lists *)l, e, idx, p, col->path + col->step_motion,
                             s->tested, s->measured, end_drift);
     }
     return pushed;
@@ -802,7 +761,7 @@ wc_status wci_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
 {
     if (count <= 0) return WC_OK;
     wc_particle_arrays p = wci_particle_arrays_of(c);
-    begin_paths(s, &p);
+    for (int32_t i = 0; i < c->particle_count; ++i) track(s, &p, i);
     if (refresh_candidates(s, c, colliders, count, &p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
     int32_t failsafe = 0;
     wc_status status = pass_rounds(s, c, &p, colliders, count, steps_left, threads, 1, NULL, &failsafe);
