@@ -66,6 +66,8 @@ struct wc_collider_contacts {
     int32_t tested_capacity;
     /// Per particle: its motion over the step (start to end, as it is).
     double *motion;
+    /// Exact tests of feature pairs run so far.
+    int64_t feature_tests;
 };
 
 /* ------------------------------------------------------------------------ */
@@ -195,6 +197,8 @@ void wci_collider_contacts_destroy(wc_collider_contacts *s)
 }
 
 void wci_collider_contacts_use_filter(wc_collider_contacts *s, int use) { s->use_filter = use; }
+
+int64_t wci_collider_contacts_feature_tests(const wc_collider_contacts *s) { return s->feature_tests; }
 
 /* ------------------------------------------------------------------------ */
 /* Candidates                                                               */
@@ -593,6 +597,7 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
             int touch = kind->count == 3 ? wci_narrow_vertex_triangle(p, idx, col, f, ccd, r, &d2, &ct)
                                          : wci_narrow_edge_edge(p, idx, col, f, ccd, r, &d2, &ct);
             s->tested[at] = 1, s->measured[at] = sqrt(d2);
+            ++s->feature_tests;
             if (!touch) continue;
             ct.friction = mu, ct.wet_friction = c->material.wet_friction;
             uint8_t moved[4];

@@ -64,4 +64,9 @@ wc_status wci_collider_contacts_recheck(wc_cloth *cloth, wc_collider_contacts *s
 /// bit; tests compare the two.
 void wci_collider_contacts_use_filter(wc_collider_contacts *state, int use);
 
+/// How many exact tests of feature pairs (collider vertex against cloth
+/// triangle, collider edge against cloth edge) the stage has run so far:
+/// what the filter left (tests/test_collide.c).
+int64_t wci_collider_contacts_feature_tests(const wc_collider_contacts *state);
+
 #endif
