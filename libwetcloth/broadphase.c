@@ -147,22 +147,55 @@ static int overlap(const double a[6], const double b[6])
            b[2] <= a[5];
 }
 
-static int compare_int32(const void *pa, const void *pb)
+static void swap_items(int32_t *a, int32_t i, int32_t j)
 {
-    int32_t a = *(const int32_t *)pa, b = *(const int32_t *)pb;
-    return a < b ? -1 : a > b;
+    int32_t t = a[i];
+    a[i] = a[j], a[j] = t;
 }
 
-static void sort_items(int32_t *items, int32_t n)
+static void insertion_sort(int32_t *items, int32_t n)
 {
-    if (n > 24) {
-        qsort(items, (size_t)n, sizeof *items, compare_int32);
-        return;
-    }
     for (int32_t i = 1; i < n; ++i) {
         int32_t v = items[i], j = i;
         for (; j > 0 && items[j - 1] > v; --j) items[j] = items[j - 1];
         items[j] = v;
+    }
+}
+
+/* Ascending, in place. A query's items are distinct, so the order is the
+ * same whatever the sort; a typed quicksort (median of three, the smaller
+ * side first so the stack stays shallow) costs a fraction of qsort's calls
+ * through a comparison pointer, which particles outside their lists' cover
+ * felt on a dense collider (5 % of its collision time). */
+static void sort_items(int32_t *items, int32_t n)
+{
+    int32_t lo_stack[STACK_DEPTH], hi_stack[STACK_DEPTH], depth = 0, lo = 0, hi = n;
+    for (;;) {
+        while (hi - lo > 24 && depth < STACK_DEPTH) {
+            int32_t *a = items + lo, m = (hi - lo) / 2, last = hi - lo - 1;
+            /* median of the first, middle and last item, into the middle */
+            if (a[m] < a[0]) swap_items(a, m, 0);
+            if (a[last] < a[m]) swap_items(a, last, m);
+            if (a[m] < a[0]) swap_items(a, m, 0);
+            int32_t pivot = a[m], i = 0, j = last;
+            while (i <= j) {
+                while (a[i] < pivot) ++i;
+                while (a[j] > pivot) --j;
+                if (i <= j) swap_items(a, i++, j--);
+            }
+            /* [lo, lo + j] and [lo + i, hi): the larger waits on the stack */
+            if (j + 1 < (hi - lo) - i) {
+                lo_stack[depth] = lo + i, hi_stack[depth++] = hi;
+                hi = lo + j + 1;
+            } else {
+                lo_stack[depth] = lo, hi_stack[depth++] = lo + j + 1;
+                lo = lo + i;
+            }
+        }
+        insertion_sort(items + lo, hi - lo);
+        if (depth == 0) return;
+        --depth;
+        lo = lo_stack[depth], hi = hi_stack[depth];
     }
 }
 

@@ -30,7 +30,7 @@
 static void lists_free(wc_pair_lists *l)
 {
     wci_free(l->start), wci_free(l->count), wci_free(l->room), wci_free(l->path_at);
-    wci_free(l->least), wci_free(l->snap), wci_free(l->item), wci_free(l->d);
+    wci_free(l->least), wci_free(l->debt), wci_free(l->snap), wci_free(l->item), wci_free(l->d);
     memset(l, 0, sizeof *l);
 }
 
@@ -53,8 +53,9 @@ static int lists_init(wc_pair_lists *l, int32_t owners, int per)
     l->room = wci_alloc_array(n, sizeof *l->room);
     l->path_at = wci_alloc_array(n, sizeof *l->path_at);
     l->least = wci_alloc_array(n, sizeof *l->least);
+    l->debt = wci_alloc_array(n, sizeof *l->debt);
     l->snap = wci_alloc_array(3 * n * (size_t)(per > 0 ? per : 1), sizeof *l->snap);
-    return l->start && l->count && l->room && l->path_at && l->least && l->snap;
+    return l->start && l->count && l->room && l->path_at && l->least && l->debt && l->snap;
 }
 
 /* Moves every list to the front of a pool of `capacity`, in owner order,
@@ -94,6 +95,7 @@ static int lists_put(wc_pair_lists *l, int32_t k, const int32_t *items, const do
     for (int32_t j = 0; j < n; ++j)
         if (d0[j] < least) least = d0[j];
     l->least[k] = least;
+    l->debt[k] = 0.0;
     memcpy(l->snap + 3 * (size_t)l->per * (size_t)k, snap, 3 * (size_t)l->per * sizeof *snap);
     if (n > l->room[k]) {
         l->garbage += l->room[k];
@@ -494,14 +496,15 @@ double wci_pair_lists_end_drift(const wc_pair_lists *l, int32_t k, const int32_t
 }
 
 void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
-                         const wc_particle_arrays *p, double collider_path,
-                         const uint8_t *tested, const double *measured, double drift_end)
+                         const wc_particle_arrays *p, double collider_path, const int32_t *at,
+                         const double *measured2, int32_t n, double least_unmeasured,
+                         double drift_end)
 {
-    double least = INFINITY;
-    for (int32_t j = 0; j < l->count[k]; ++j) {
-        double *d = l->d + l->start[k];
-        d[j] = tested[j] ? measured[j] : d[j] - drift_end;
-        if (d[j] < least) least = d[j];
+    double *d = l->d + l->start[k], debt = l->debt[k] + drift_end, least = least_unmeasured;
+    l->debt[k] = debt;
+    for (int32_t j = 0; j < n; ++j) {
+        d[at[j]] = sqrt(measured2[j]) + debt;
+        if (d[at[j]] < least) least = d[at[j]];
     }
     l->least[k] = least;
     l->path_at[k] = collider_path;

@@ -57,13 +57,11 @@ struct wc_collider_contacts {
     /// Per element scratch: a mark and a list.
     uint8_t *visit_mark;
     int32_t *visit_list;
-    /// The feature pass' survivors of one element, and per listed item
-    /// whether it was measured and at what distance (snapshots).
+    /// The feature pass' survivors of one element (positions in its list)
+    /// and the distance measured for each (snapshots); room for kept_capacity.
     int32_t *kept;
-    int32_t kept_capacity;
-    uint8_t *tested;
     double *measured;
-    int32_t tested_capacity;
+    int32_t kept_capacity;
     /// Per particle: its motion over the step (start to end, as it is).
     double *motion;
     /// Exact tests of feature pairs run so far.
@@ -190,7 +188,7 @@ void wci_collider_contacts_destroy(wc_collider_contacts *s)
     void *blocks[] = {s->cand, s->el.edges, s->el.triangles_start, s->el.triangles_of,
                       s->el.edges_start, s->el.edges_of, s->recheck, s->changed, s->shifted, s->carry,
                       s->moved, s->moving, s->moved_list, s->moving_list, s->rebase_list,
-                      s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->tested, s->measured,
+                      s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->measured,
                       s->motion};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wci_free(blocks[k]);
     wci_free(s);
@@ -341,11 +339,73 @@ static int32_t survivors(const wc_pair_lists *l, int32_t k, double reach, int al
     const int32_t *item = l->item + l->start[k];
     const double *d = l->d + l->start[k];
     int32_t n = 0;
+    if (l->count[k] <= capacity) {
+        /* Room for every item: each position is written and counted if it
+         * is kept, without a branch. Which items the filter keeps changes
+         * from visit to visit, and the branch that skipped them was
+         * mispredicted often enough to make this scan a tenth of a dense
+         * collider's whole step. */
+        for (int32_t j = 0; j < l->count[k]; ++j) {
+            out[n] = j;
+            n += (item[j] > after) & (all | !(d[j] > reach));
+        }
+        return n;
+    }
     for (int32_t j = 0; j < l->count[k]; ++j) {
         if (item[j] <= after || (!all && d[j] > reach)) continue;
         if (n < capacity) out[n] = j;
         ++n;
     }
+    return n;
+}
+
+/* Gathers position j of a list into out if its bound d is within `bound`,
+ * and otherwise lowers *least to d; returns the new count. */
+static int32_t gather_one(int32_t j, double d, double bound, int32_t *out, int32_t n, double *least)
+{
+    int keep = !(d > bound);
+    double other = keep ? INFINITY : d;
+    out[n] = j;
+    *least = other < *least ? other : *least;
+    return n + keep;
+}
+
+/* The same for an element's list, whose scratch has room for all of it:
+ * the positions of the items after `after` with d within `bound` (the
+ * reach plus the owner's debt), and into *rest the least d of the others
+ * (INFINITY if none): what a renewal needs to know of the items it does not
+ * measure. */
+static int32_t element_survivors(const wc_pair_lists *l, int32_t k, double bound, int all,
+                                 int32_t after, int32_t *out, double *rest)
+{
+    const int32_t *item = l->item + l->start[k];
+    const double *d = l->d + l->start[k];
+    int32_t n = 0, count = l->count[k], j = 0;
+    if (after < 0 && !all) {
+        /* The first gathering of a visit (most of them): every item comes
+         * after, so only the bounds are read, without a branch (which items
+         * the filter keeps changes from visit to visit, and mispredicted
+         * skips made this scan a tenth of a dense collider's step), and
+         * into four running minima (one would chain every item's compare to
+         * the last one's; the least of a set is the same however grouped). */
+        double least[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+        for (; j + 4 <= count; j += 4) {
+            n = gather_one(j, d[j], bound, out, n, &least[0]);
+            n = gather_one(j + 1, d[j + 1], bound, out, n, &least[1]);
+            n = gather_one(j + 2, d[j + 2], bound, out, n, &least[2]);
+            n = gather_one(j + 3, d[j + 3], bound, out, n, &least[3]);
+        }
+        for (; j < count; ++j) n = gather_one(j, d[j], bound, out, n, &least[0]);
+        double a = least[0] < least[1] ? least[0] : least[1], b = least[2] < least[3] ? least[2] : least[3];
+        *rest = a < b ? a : b;
+        return n;
+    }
+    double least = INFINITY;
+    for (; j < count; ++j) {
+        if (item[j] <= after) continue;
+        n = all ? (out[n] = j, n + 1) : gather_one(j, d[j], bound, out, n, &least);
+    }
+    *rest = least;
     return n;
 }
 
@@ -543,18 +603,17 @@ static double feature_reach(double r) { return r * sqrt(1.0 - WC_FEATURE_SLACK);
 /* Room for the survivors and measurements of a list of n items. */
 static int feature_scratch(wc_collider_contacts *s, int32_t n)
 {
-    if (n <= s->kept_capacity && n <= s->tested_capacity) return 1;
+    if (n <= s->kept_capacity) return 1;
     int32_t cap = 2 * n + 16;
     int32_t *kept = wci_alloc_array((size_t)cap, sizeof *kept);
-    uint8_t *tested = wci_alloc_array((size_t)cap, 1);
     double *measured = wci_alloc_array((size_t)cap, sizeof *measured);
-    if (!kept || !tested || !measured) {
-        wci_free(kept), wci_free(tested), wci_free(measured);
+    if (!kept || !measured) {
+        wci_free(kept), wci_free(measured);
         return 0;
     }
-    wci_free(s->kept), wci_free(s->tested), wci_free(s->measured);
-    s->kept = kept, s->tested = tested, s->measured = measured;
-    s->kept_capacity = s->tested_capacity = cap;
+    wci_free(s->kept), wci_free(s->measured);
+    s->kept = kept, s->measured = measured;
+    s->kept_capacity = cap;
     return 1;
 }
 
@@ -573,30 +632,28 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
     double reach = feature_reach(r) + FILTER_EPSILON(r);
     double drift = wci_pair_lists_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
     /* nothing in the list can touch: the cheap way out of most visits */
-    if (!s->use_filter ? l->count[e] == 0 : l->least[e] - drift > reach) return 0;
-    double mu = sqrt(c->material.friction * col->friction);
-    int32_t after = -1;
+    if (!s->use_filter ? l->count[e] == 0 : l->least[e] - l->debt[e] - drift > reach) return 0;
+    double mu = sqrt(c->material.friction * col->friction), rest = INFINITY;
+    int32_t after = -1, n = 0;
     int pushed = 0;
-    if (!feature_scratch(s, l->count[e])) return -1;
-    memset(s->tested, 0, (size_t)l->count[e]);
     for (;;) {
-        /* a push may have rebased the list and grown it; what was measured
-         * before is of no use then (no renewal after a push) */
-        if (pushed && !feature_scratch(s, l->count[e])) return -1;
+        /* a push may have rebased the list and grown it */
+        if (!feature_scratch(s, l->count[e])) return -1;
         double motion = 0.0;
         for (int j = 0; j < kind->count; ++j)
             if (s->motion[idx[j]] > motion) motion = s->motion[idx[j]];
-        int32_t n = survivors(l, e, reach + drift, !s->use_filter, after, s->kept, s->kept_capacity);
+        n = element_survivors(l, e, reach + drift + l->debt[e], !s->use_filter, after, s->kept, &rest);
         int32_t hit = -1;
         for (int32_t j = 0; j < n && hit < 0; ++j) {
-            int32_t at = s->kept[j], f = l->item[l->start[e] + at];
+            int32_t f = l->item[l->start[e] + s->kept[j]];
             double fm = feature_motion(col, kind, f);
             int ccd = wci_narrow_needs_ccd(motion > fm ? motion : fm, r);
             double d2;
             wc_contact ct;
             int touch = kind->count == 3 ? wci_narrow_vertex_triangle(p, idx, col, f, ccd, r, &d2, &ct)
                                          : wci_narrow_edge_edge(p, idx, col, f, ccd, r, &d2, &ct);
-            s->tested[at] = 1, s->measured[at] = sqrt(d2);
+            /* squared: the renewal takes the root, off this loop's path */
+            s->measured[j] = d2;
             ++s->feature_tests;
             if (!touch) continue;
             ct.friction = mu, ct.wet_friction = c->material.wet_friction;
@@ -612,10 +669,12 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
         drift = wci_pair_lists_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
     }
     if (!pushed) {
-        /* measured at the ends as they are: a fresh snapshot */
+        /* One gathering, every survivor measured at the ends as they are:
+         * a fresh snapshot. (After a push the list may have been made again,
+         * and what was measured before the push is of no use.) */
         double end_drift = wci_pair_lists_end_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
-        wci_pair_lists_renew((wc_pair_lists *)l, e, idx, p, col->path + col->step_motion,
-                            s->tested, s->measured, end_drift);
+        wci_pair_lists_renew((wc_pair_lists *)l, e, idx, p, col->path + col->step_motion, s->kept,
+                            s->measured, n, rest, end_drift);
     }
     return pushed;
 }

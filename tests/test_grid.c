@@ -131,6 +131,10 @@ static void tree(int32_t n, double item_size, double query_size, int queries)
     /* a full buffer: the count without overrun */
     double all[6] = {-10, -10, -10, 10, 10, 10};
     CHECK(wci_bvh_query(&b, all, found, 1) == n, "a query with a small buffer must still count all");
+    /* every item at once: the sort's largest input, in the tree's order */
+    int32_t every = wci_bvh_query(&b, all, found, n), out_of_order = every != n;
+    for (int32_t k = 0; k < every && !out_of_order; ++k) out_of_order = found[k] != k;
+    CHECK(!out_of_order, "a query of every item must give 0 .. %d in order", (int)n - 1);
     printf("tree: %d items, %d queries twice (after a refit), %ld hits, %d mismatches\n", (int)n,
            queries, total, mismatches);
     CHECK(mismatches == 0, "tree queries differ from brute force");
