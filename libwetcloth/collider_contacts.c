@@ -412,7 +412,7 @@ static int32_t element_survivors(const wc_pair_lists *l, int32_t k, double bound
 /* The collider triangles after `after` whose boxes meet the particle's
  * motion grown by r, from the tree, in turn; after a push the motion has
  * changed and the tree is asked again. For a particle outside its lists'
- * cover, or with more survivors than a stack holds. */
+ * cover (or when the room for its survivors cannot be had). */
 static int direct_triangles(particle_run *run, const wc_collider *col, double r, int32_t after)
 {
     int moved = 0;
@@ -450,26 +450,42 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
 {
     const wc_particle_arrays *p = run->p;
     const wc_pair_lists *l = &cand->particles;
-    int32_t i = run->i, after = -1, kept[DIRECT_STACK];
+    int32_t i = run->i, after = -1, stack[DIRECT_STACK], *kept = stack, room = DIRECT_STACK;
     double path = col->path + col->step_motion, drift = collider_drift(col, l->path_at[i]);
     int moved = 0;
     for (;;) {
         double d = wci_candidates_displacement(cand, p, i);
         if (!wc_candidates_covers(cand, i, d, path)) {
             run->leaves_cover = 1;
-            return moved | direct_triangles(run, col, r, after);
+            moved |= direct_triangles(run, col, r, after);
+            break;
         }
         double reach = r + d + drift + FILTER_EPSILON(r);
-        int32_t n = survivors(l, i, reach, !use_filter, after, kept, DIRECT_STACK);
-        if (n > DIRECT_STACK) return moved | direct_triangles(run, col, r, after);
-        if (n == 0) return moved;
+        int32_t n = survivors(l, i, reach, !use_filter, after, kept, room);
+        if (n > room) {
+            /* More survivors than the stack holds: a UV sphere's pole
+             * gathers hundreds of slivers within r of a particle. Room for
+             * the whole list is still far cheaper than asking the tree for
+             * the motion's box, which finds more of them, unsorted (the
+             * 30,624-triangle sphere's pole: 530-870 triangles a query). */
+            int32_t *grown = wci_alloc_array((size_t)l->count[i], sizeof *grown);
+            if (!grown) {
+                moved |= direct_triangles(run, col, r, after);
+                break;
+            }
+            if (kept != stack) wci_free(kept);
+            kept = grown, room = l->count[i];
+            n = survivors(l, i, reach, !use_filter, after, kept, room);
+        }
         const int32_t *item = l->item + l->start[i];
         int32_t pushed = -1;
         for (int32_t j = 0; j < n && pushed < 0; ++j)
             if (test_triangle(run, col, item[kept[j]], r)) pushed = item[kept[j]];
-        if (pushed < 0) return moved;
+        if (pushed < 0) break;
         moved = 1, after = pushed;
     }
+    if (kept != stack) wci_free(kept);
+    return moved;
 }
 
 /* Particle i against every collider, up to PARTICLE_PASSES times; returns

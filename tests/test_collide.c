@@ -615,6 +615,78 @@ static void resting_pairs_skipped(void)
     CHECK(filtered_hash == all_hash, "the filter changed the result at rest");
 }
 
+/* A UV sphere's pole: all `segments` triangles of its fan meet there, so a
+ * particle resting on it has each of them within the contact distance, more
+ * than the particle pass holds on its stack (256). A 7 x 7 cloth of 0.12 m
+ * dropped onto the pole of a 512 x 24 sphere (radius 0.3 m, Blender's
+ * collider thickness) must rest on it, never nearer the mesh than 0.9 of
+ * the contact distance (the response puts a particle at r; a fold's feature
+ * contacts have a slack of 1 %), to the same bits with the filter and with
+ * every listed pair tested. */
+static uint64_t pole_drop(int use_filter, double *nearest, int32_t *fan_within_r)
+{
+    enum { SEGMENTS = 512, RINGS = 24 };
+    static double v[3 * (2 + (RINGS - 1) * SEGMENTS)];
+    static int32_t t[3 * 2 * SEGMENTS * (RINGS - 1)];
+    wc_world_def def = wc_world_def_default();
+    def.thread_count = 1;
+    wc_world *w = scene_world_from(&def);
+    int32_t nt, col, cl;
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertex_count = scene_uv_sphere(0.3, SEGMENTS, RINGS, v, t, &nt);
+    d.vertices = v, d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
+    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = 7;
+    g.size_u = g.size_v = 0.12;
+    g.center[2] = 0.36;
+    CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
+    double r = d.thickness + g.material.thickness, xyz[3 * 49];
+    *nearest = INFINITY, *fan_within_r = 0;
+    for (int f = 0; f < 12; ++f) {
+        advance_or_fail(w, 1.0 / 24, 0);
+        if (f == 0) wci_collider_contacts_use_filter(w->cloths[cl]->collider_contacts, use_filter);
+        CHECK(wc_cloth_get_positions(w, cl, xyz, 49) == WC_OK, "%s", wc_world_last_error(w));
+        /* the distance to the mesh (its facets lie inside the sphere) */
+        for (int32_t i = 0; i < 49; ++i)
+            for (int32_t k = 0; k < nt; ++k) {
+                double bary[3];
+                const int32_t *tri = t + 3 * k;
+                double d2 = wci_point_triangle_closest(xyz + 3 * i, v + 3 * tri[0], v + 3 * tri[1],
+                                                       v + 3 * tri[2], bary);
+                if (sqrt(d2) < *nearest) *nearest = sqrt(d2);
+            }
+    }
+    /* the middle particle (24) at the end: the fan's triangles within r (it
+     * rests at r from the pole, to rounding) */
+    for (int32_t k = 0; k < SEGMENTS; ++k) {
+        double bary[3];
+        const int32_t *tri = t + 3 * k;
+        if (wci_point_triangle_closest(xyz + 3 * 24, v + 3 * tri[0], v + 3 * tri[1], v + 3 * tri[2],
+                                       bary) <= 1.001 * r * r)
+            ++*fan_within_r;
+    }
+    uint64_t h = scene_hash_positions(w, cl);
+    wc_world_destroy(w);
+    return h;
+}
+
+static void rest_on_a_pole(void)
+{
+    double nearest_filtered, nearest_all;
+    int32_t fan, fan_all;
+    uint64_t filtered = pole_drop(1, &nearest_filtered, &fan);
+    uint64_t all = pole_drop(0, &nearest_all, &fan_all);
+    double r = 0.02 + wc_material_default().thickness;
+    printf("pole of a 512-segment sphere: nearest %.5f m (r %.4f), %d fan triangles within r of "
+           "the middle particle\n", nearest_filtered, r, (int)fan);
+    CHECK(fan > 256, "the middle particle has only %d fan triangles within r: the scene does not "
+          "test a list longer than the stack", (int)fan);
+    CHECK(nearest_filtered > 0.9 * r, "a particle came within %.5f m of the sphere (r = %.4f)",
+          nearest_filtered, r);
+    CHECK(filtered == all, "the filter changed the result on the pole");
+}
+
 static double seconds(void)
 {
     return (double)clock() / CLOCKS_PER_SEC;
@@ -629,6 +701,7 @@ int main(void)
     rest_on_convex(WC_SHAPE_BOX, "box");
     rest_on_convex(WC_SHAPE_CONVEX_HULL, "hull");
     fast_particle();
+    rest_on_a_pole();
     friction_holds_where_it_met();
     edge_turning_over_an_edge();
     triangle_turning_over_a_vertex();
