@@ -477,6 +477,7 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
             kept = grown, room = l->count[i];
             n = survivors(l, i, reach, !use_filter, after, kept, room);
         }
+        if (n == 0) break; /* (the pool may not exist yet) */
         const int32_t *item = l->item + l->start[i];
         int32_t pushed = -1;
         for (int32_t j = 0; j < n && pushed < 0; ++j)
