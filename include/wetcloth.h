@@ -701,6 +701,12 @@ typedef struct wc_step_stats {
     int64_t solver_iterations;
     /// Threads the last step ran on (see wc_world_def.adapt_threads).
     int32_t threads;
+    /// Steps of the last wc_world_step or wc_world_advance that were taken
+    /// again as two half steps because their collisions would have torn a
+    /// cloth (stretched a link past 1.5 times its rest length, by more than
+    /// half of it, in that one step), counting each halving, down to 3
+    /// halvings (what still tears then is kept); >= 0.
+    int32_t halved_steps;
 } wc_step_stats;
 
 /// Statistics of the last step.

@@ -99,3 +99,23 @@ int32_t wci_step_guard_check(const wc_cloth *c, const wc_step_guard *g, double d
                 (next->run >= MIN_RUN && next->run * log(next->growth) >= log(RUN_POWER));
     return grown && next->change * dt * dt >= FLOOR * next->scale ? p : -1;
 }
+
+static double squared_length(const double *x, const double *y, const double *z, int32_t a, int32_t b)
+{
+    double d[3] = {x[a] - x[b], y[a] - y[b], z[a] - z[b]};
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+int32_t wci_step_tears(const wc_cloth *c, double ratio, double growth)
+{
+    const wc_link_set *s = &c->topology.stretch;
+    for (int32_t e = 0; e < s->count; ++e) {
+        double limit = ratio * s->rest[e];
+        double end2 = squared_length(c->nx, c->ny, c->nz, s->a[e], s->b[e]);
+        /* the root only for the rare link past the ratio */
+        if (!(end2 > limit * limit)) continue;
+        double start = sqrt(squared_length(c->x, c->y, c->z, s->a[e], s->b[e]));
+        if (sqrt(end2) - start > growth * s->rest[e]) return e;
+    }
+    return -1;
+}

@@ -52,4 +52,32 @@ typedef struct wc_step_guard {
 int32_t wci_step_guard_check(const struct wc_cloth *cloth, const wc_step_guard *guard, double dt,
                             int threads, wc_step_guard *next);
 
+/* Tearing. A large step can also go wrong without growing oscillations: a
+ * contact answered from a configuration the step's length made ambiguous
+ * (a cloth triangle crushed to a sliver between a bending dense tube's
+ * facets, whose normal turns over within the step) pushes the cloth a
+ * contact distance the wrong way, and the links it stretches feed the next
+ * steps until the cloth tears (the bending 14,784-vertex tube at 12 implicit
+ * steps per frame: a link from 1.015 to 1.86 times its rest length in one
+ * step, 3.5 the next, 24 two steps later). The same scene at 24 steps per
+ * frame holds within 1.03. So a step whose collisions stretch a stretch
+ * link past WC_TEAR_RATIO times its rest length, by more than
+ * WC_TEAR_GROWTH times it in that one step, is taken again as two half
+ * steps (world.c), down to WC_TEAR_HALVINGS halvings; what still tears then
+ * is kept. On the tube that takes 5 steps again in 24 frames (the first: a
+ * link from 1.002 to 1.69) and the cloth holds within 1.08. Stretch that
+ * builds over several steps is not this (the soaked 2 m cloth landing on
+ * the dense sphere stretches links to about 1.6 over several steps). The
+ * same jump happens, once, to the add-on's 17 x 17 drape resting on the
+ * thesis sphere (frame 20: a link from 1.03 to 1.54 in one step); a
+ * quarter instead of a half as the growth took two of its steps again. */
+#define WC_TEAR_RATIO 1.5
+#define WC_TEAR_GROWTH 0.5
+#define WC_TEAR_HALVINGS 3
+
+/// The first stretch link of the cloth that the step from (x, y, z) to
+/// (nx, ny, nz) stretches past `ratio` times its rest length, by more than
+/// `growth` times it (WC_TEAR_RATIO and WC_TEAR_GROWTH: it tears), or -1.
+int32_t wci_step_tears(const struct wc_cloth *cloth, double ratio, double growth);
+
 #endif

@@ -111,6 +111,7 @@ wc_status wc_world_create(const wc_world_def *def, wc_world **out_world, wc_mess
     wc_world *w = wci_alloc_array(1, sizeof *w);
     if (!w) return wci_fail(out_message, WC_ERROR_OUT_OF_MEMORY, "out of memory creating a world");
     w->def = *def;
+    w->tear_ratio = WC_TEAR_RATIO, w->tear_growth = WC_TEAR_GROWTH;
     wci_thread_tuner_create(&w->tuner, wci_thread_count(def->thread_count), def->adapt_threads);
     *out_world = w;
     return WC_OK;
@@ -377,6 +378,25 @@ static wc_status collide_stage(wc_world *w, const step_context *ctx)
     return s;
 }
 
+/* Whether the step's collisions would tear a cloth (step_guard.h). Without
+ * collisions nothing is looked at: the tear comes from a contact's answer. */
+static int step_tears(const wc_world *w, const step_context *ctx)
+{
+    if (!ctx->colliding) return 0;
+    for (int32_t c = 0; c < w->cloth_count; ++c)
+        if (wci_step_tears(w->cloths[c], w->tear_ratio, w->tear_growth) >= 0) return 1;
+    return 0;
+}
+
+/* A step refused after its collisions: their contact state put back, as a
+ * failed step's is, so the half steps start from the world as it was. */
+static void undo_collisions(wc_world *w, const step_context *ctx)
+{
+    if (!ctx->colliding) return;
+    wci_contact_backup_restore(&w->backup, w->cloths, w->cloth_count);
+    wci_cloth_group_restore(w->group);
+}
+
 /* The wet response (stuck particles), then the step's positions become the
  * current ones for every cloth at once. */
 static void commit_stage(wc_world *w, const step_context *ctx)
@@ -406,7 +426,7 @@ static void wetness_stage(wc_world *w, const step_context *ctx)
  * exactly as it was. The pins are at pin_start of the way to their targets
  * when the step starts and at pin_fraction when it ends. */
 static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_left,
-                            double pin_start, double pin_fraction)
+                            double pin_start, double pin_fraction, int may_refuse, int *refused)
 {
     step_context ctx;
     ctx.dt = dt, ctx.share = share, ctx.steps_left = steps_left;
@@ -428,6 +448,11 @@ static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_
     s = collide_stage(w, &ctx);
     if (s) return s;
     t1 = wci_clock_seconds(), phase[2] += t1 - t0, t0 = t1;
+    if (may_refuse && step_tears(w, &ctx)) {
+        undo_collisions(w, &ctx);
+        *refused = 1;
+        return WC_OK;
+    }
 
     commit_stage(w, &ctx);
     wetness_stage(w, &ctx);
@@ -439,12 +464,36 @@ static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_
 /* A step, timed for the thread tuner: the next step's thread count comes
  * from how long this one took on its count. */
 static wc_status timed_step(wc_world *w, double dt, double share, int32_t steps_left,
-                            double pin_start, double pin_fraction)
+                            double pin_start, double pin_fraction, int may_refuse, int *refused)
 {
     double start = wci_clock_seconds();
-    wc_status s = world_step(w, dt, share, steps_left, pin_start, pin_fraction);
+    wc_status s = world_step(w, dt, share, steps_left, pin_start, pin_fraction, may_refuse, refused);
     wci_thread_tuner_record(&w->tuner, wci_clock_seconds() - start);
     return s;
+}
+
+/* A step that would tear a cloth is taken again as two half steps, each of
+ * them the same way, down to WC_TEAR_HALVINGS halvings (step_guard.h). The
+ * first half covers half of the step's share of what is left of the
+ * advance and of the pins' way; the second the rest. *reached becomes the
+ * pins' fraction at the end of the last step that was committed. */
+static wc_status refined_step(wc_world *w, double dt, double share, int32_t steps_left,
+                              double pin_start, double pin_fraction, int halvings, double *reached)
+{
+    int refused = 0;
+    wc_status s = timed_step(w, dt, share, steps_left, pin_start, pin_fraction,
+                             halvings < WC_TEAR_HALVINGS, &refused);
+    if (s) return s;
+    if (!refused) {
+        *reached = pin_fraction;
+        return WC_OK;
+    }
+    ++w->halved_steps;
+    double middle = 0.5 * (pin_start + pin_fraction), half = 0.5 * share;
+    s = refined_step(w, 0.5 * dt, half, 2 * steps_left + 1, pin_start, middle, halvings + 1, reached);
+    if (s) return s;
+    return refined_step(w, 0.5 * dt, half / (1.0 - half), 2 * steps_left, middle, pin_fraction,
+                        halvings + 1, reached);
 }
 
 /* Before a step or an advance: no phase time yet. */
@@ -452,6 +501,7 @@ static void start_timing(wc_world *w)
 {
     memset(w->phase_seconds, 0, sizeof w->phase_seconds);
     w->solver_iterations = 0;
+    w->halved_steps = 0;
 }
 
 /* After it: the phase times of all its steps into the stats. */
@@ -462,6 +512,7 @@ static void finish_timing(wc_world *w)
     w->stats.collide_seconds = w->phase_seconds[2];
     w->stats.wet_seconds = w->phase_seconds[3];
     w->stats.solver_iterations = w->solver_iterations;
+    w->stats.halved_steps = w->halved_steps;
 }
 
 /* After an advance, pins start the next one from where they are: a hard
@@ -504,9 +555,10 @@ wc_status wc_world_step(wc_world *w, double dt)
     wc_status s = check_step_length(w, "wc_world_step: dt", dt);
     if (s) return s;
     start_timing(w);
-    s = timed_step(w, dt, 1.0, 0, 0.0, 1.0);
+    double reached = 0.0;
+    s = refined_step(w, dt, 1.0, 0, 0.0, 1.0, 0, &reached);
     finish_timing(w);
-    settle_pins(w, s ? 0.0 : 1.0);
+    settle_pins(w, reached);
     return s;
 }
 
@@ -540,14 +592,15 @@ wc_status wc_world_advance(wc_world *w, double frame_dt, int32_t substeps)
     double dt = frame_dt / substeps;
     start_timing(w);
     int32_t done = 0; /* substeps that succeeded */
+    double reached = 0.0;
     while (done < substeps) {
-        s = timed_step(w, dt, 1.0 / (substeps - done), substeps - done - 1,
-                       (double)done / substeps, (double)(done + 1) / substeps);
+        s = refined_step(w, dt, 1.0 / (substeps - done), substeps - done - 1,
+                         (double)done / substeps, (double)(done + 1) / substeps, 0, &reached);
         if (s) break;
         ++done;
     }
     finish_timing(w);
-    settle_pins(w, done == substeps ? 1.0 : (double)done / substeps);
+    settle_pins(w, done == substeps ? 1.0 : reached);
     w->last_substeps = substeps;
     return s;
 }

@@ -27,6 +27,11 @@ struct wc_world {
     double phase_seconds[4];
     /// Linear-solver iterations since start_timing (world.c).
     int64_t solver_iterations;
+    /// Steps taken again as halves since start_timing, and what tears
+    /// (step_guard.h: WC_TEAR_RATIO and WC_TEAR_GROWTH; a test may set
+    /// others to make every step be taken again).
+    int32_t halved_steps;
+    double tear_ratio, tear_growth;
     /// Message of the last failed call. Calls that take a const world still
     /// report here: the world itself is never const-defined (it comes from
     /// wc_world_create), so writing through a cast pointer is well defined.

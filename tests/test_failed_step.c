@@ -14,6 +14,13 @@
  * collision caches, the contact history) must not differ either, the twins
  * then run on and must still be equal at the end.
  *
+ * A step whose collisions would tear the cloth is refused the same way and
+ * taken again as two half steps (step_guard.h). With every step made to
+ * count as tearing (the world's tear ratio at 0), an advance of n steps
+ * refuses each one and its halves down to the last halving, 7 refusals per
+ * step, and must give the bits of an advance of 8n steps that refused
+ * nothing: the refused steps leave no trace either.
+ *
  * The out-of-memory failures, which come in every phase of a step, are
  * test_oom's; this test covers the failures a step finds in its numbers. */
 #include <math.h>
@@ -21,8 +28,10 @@
 #include <string.h>
 
 #include "scenes.h"
+#include "step_guard.h"
 #include "test_util.h"
 #include "wetcloth.h"
+#include "world.h"
 
 #define SIDE 8
 #define N (SIDE * SIDE)
@@ -178,10 +187,86 @@ static void run(wc_integrator integrator)
     wc_world_destroy(b);
 }
 
+/* The tear criterion on one link of a 3 x 3 cloth, its second particle
+ * moved along it: at the start (x) to `from`, at the end (nx) to `to`
+ * times its rest length. */
+static int32_t tears_at(wc_world *w, double from, double to)
+{
+    wc_cloth *c = w->cloths[0];
+    const wc_link_set *l = &c->topology.stretch;
+    int32_t a = l->a[0], b = l->b[0];
+    double *pos[3] = {c->x, c->y, c->z}, *end[3] = {c->nx, c->ny, c->nz}, d[3];
+    double len = 0.0;
+    for (int k = 0; k < 3; ++k) d[k] = pos[k][b] - pos[k][a], len += d[k] * d[k];
+    len = sqrt(len);
+    static double keep[3][N];
+    for (int k = 0; k < 3; ++k) memcpy(keep[k], pos[k], (size_t)c->particle_count * sizeof(double));
+    for (int k = 0; k < 3; ++k) {
+        pos[k][b] = pos[k][a] + d[k] / len * from * l->rest[0];
+        memcpy(end[k], pos[k], (size_t)c->particle_count * sizeof(double));
+        end[k][b] = pos[k][a] + d[k] / len * to * l->rest[0];
+    }
+    int32_t e = wci_step_tears(c, WC_TEAR_RATIO, WC_TEAR_GROWTH);
+    for (int k = 0; k < 3; ++k) memcpy(pos[k], keep[k], (size_t)c->particle_count * sizeof(double));
+    return e;
+}
+
+static void tear_criterion(void)
+{
+    wc_world *w = scene_world(1);
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = 3;
+    int32_t cl;
+    CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
+    CHECK(tears_at(w, 1.0, 1.6) == 0, "1.0 to 1.6 times the rest length in a step must tear");
+    CHECK(tears_at(w, 1.0, 1.45) < 0, "1.0 to 1.45 (under the ratio) must not tear");
+    CHECK(tears_at(w, 1.2, 1.6) < 0, "1.2 to 1.6 (growth under a half) must not tear");
+    CHECK(tears_at(w, 1.6, 3.0) == 0, "1.6 to 3.0 in a step must tear");
+    CHECK(tears_at(w, 1.0, 1.0) < 0, "a link at rest must not tear");
+    wc_world_destroy(w);
+}
+
+/* Twin A refuses every step down to the last halving; twin B takes the
+ * steps A ends with, 8 times as many, and refuses none. n is a power of two
+ * (the pins' fractions and the steps then halve exactly) at which A's
+ * first, refused, steps are within the stable step (Verlet's guard would
+ * fail them otherwise). */
+static void refused_steps(wc_integrator integrator)
+{
+    const char *name = NAME[integrator];
+    wc_world *a = twin(integrator), *b = twin(integrator);
+    a->tear_ratio = 0.0, a->tear_growth = -INFINITY;
+    int32_t n = 1;
+    while (FRAME / n > 0.9 * wc_world_stable_dt(a)) n *= 2;
+    int32_t halvings = (1 << WC_TEAR_HALVINGS) - 1, wrong_count = 0;
+    for (int f = 0; f < 30; ++f) {
+        CHECK(wc_world_advance(a, FRAME, n) == WC_OK, "%s A: %s", name, wc_world_last_error(a));
+        CHECK(wc_world_advance(b, FRAME, 8 * n) == WC_OK, "%s B: %s", name, wc_world_last_error(b));
+        wrong_count += wc_world_get_stats(a).halved_steps != halvings * n ||
+                       wc_world_get_stats(b).halved_steps != 0;
+    }
+    CHECK(wrong_count == 0, "%s: %d frames where A did not halve %d times per step or B halved",
+          name, wrong_count, (int)halvings);
+    snapshot s;
+    take(a, &s);
+    int touching = 0;
+    for (int i = 0; i < N; ++i) touching += s.contact[i] != 0;
+    CHECK(touching > 0, "%s: the cloth should touch the sphere by now", name);
+    compare(a, b, "30 frames of steps refused and halved", name);
+    printf("%s: %d steps per frame each refused %d times, %d particles touching: the bits of %d "
+           "steps per frame\n", name, (int)n, (int)halvings, touching, (int)(8 * n));
+    wc_world_destroy(a);
+    wc_world_destroy(b);
+}
+
 int main(void)
 {
     run(WC_INTEGRATOR_VERLET);
     run(WC_INTEGRATOR_XPBD);
     run(WC_INTEGRATOR_IMPLICIT);
+    tear_criterion();
+    refused_steps(WC_INTEGRATOR_VERLET);
+    refused_steps(WC_INTEGRATOR_XPBD);
+    refused_steps(WC_INTEGRATOR_IMPLICIT);
     return test_report("test_failed_step");
 }

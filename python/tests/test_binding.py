@@ -451,10 +451,12 @@ def test_stats_keys():
         s = w.stats
         assert set(s) == {"steps", "time", "last_substeps", "collider_contacts",
                           "cloth_contacts", "failsafe_particles", "stuck_particles",
-                          "step_seconds", "phase_seconds", "solver_iterations", "threads"}
+                          "step_seconds", "phase_seconds", "solver_iterations", "threads",
+                          "halved_steps"}
         assert s["steps"] == s["last_substeps"] > 0 and s["step_seconds"] > 0
         assert s["solver_iterations"] == 0  # Verlet solves no linear system
         assert s["threads"] >= 1
+        assert s["halved_steps"] == 0  # no collider: no step is looked at
 
 
 def test_adapt_threads():

@@ -508,7 +508,9 @@ class World:
         last step(), or of all substeps of the last advance(); and
         solver_iterations, the implicit integrator's conjugate-gradient
         iterations over the same steps (0 for the other integrators); threads,
-        the threads the last step ran on."""
+        the threads the last step ran on; halved_steps, the steps of the last
+        step() or advance() taken again as two half steps because their
+        collisions would have torn a cloth."""
         h = self._handle()
         s = lib.wc_world_get_stats(h)
         return {
@@ -528,6 +530,7 @@ class World:
             },
             "solver_iterations": int(s.solver_iterations),
             "threads": int(s.threads),
+            "halved_steps": int(s.halved_steps),
         }
 
 

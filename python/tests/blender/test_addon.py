@@ -236,9 +236,14 @@ def test_drape_cache(draped):
     mid = np.argmin(np.linalg.norm(original[:, :2], axis=1))
     assert SPHERE_R < world[-1, mid, 2] < SPHERE_R + 0.04
     # ... came to rest: over the last frame the part on the sphere stays
-    # put and the cloth as a whole moves little (the free corners still sway)
+    # put and the cloth as a whole moves little (the free corners still sway).
+    # The middle vertex lies on the 16-segment sphere's pole, where it
+    # shimmers by 0.1-3 mm per frame from frame 12 on at the default's 12
+    # steps per frame (measured; which frame is quiet depends on the run:
+    # 0.13 mm at the last frame, or 0.97 mm with a step at frame 20 taken
+    # again as halves); sliding off or sinking in would be centimetres.
     step = np.linalg.norm(world[-1] - world[-2], axis=1)
-    assert step[mid] < 0.0005 and step.mean() < 0.002, (step[mid], step.mean())
+    assert step[mid] < 0.004 and step.mean() < 0.002, (step[mid], step.mean())
     # ... and no vertex ever went inside the sphere
     normals, offsets = convex_planes(sphere)
     inside = np.all(world @ normals.T < offsets[None, None, :], axis=2)
