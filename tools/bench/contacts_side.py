@@ -357,8 +357,8 @@ def main():
               f"{span(bms)} | {span(bcol)} | {ratio_collide} | {q5} | {q5r} | {eq} | "
               f"{o[0]['intersections_last']}, {b[0]['intersections_last'] if b else '-'} | "
               f"{o[0]['highest_after_landing']:.3f} / {o[0]['start_height']:.3f} | "
-              f"{o[0]['longest_link']:.2f}, {b[0]['longest_link'] if b else float('nan'):.2f}, "
-              f"{bl['longest'] if bl else float('nan'):.2f} |")
+              f"{o[0]['longest_link']:.2f}, {format(b[0]['longest_link'], '.2f') if b else '-'}, "
+              f"{format(bl['longest'], '.2f') if bl else '-'} |")
     print()
     print(f"load average after: {' '.join(open('/proc/loadavg').read().split()[:3])}")
     if a.json:

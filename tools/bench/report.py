@@ -528,8 +528,12 @@ def contacts(out, quick, python, build, base, lines):
         "Grid cloths falling onto mesh colliders with Blender's default collider thickness (0.02 m) "
         "and friction 0.5, 24 frames of 1/24 s, 1 thread for ours (Blender uses its own thread "
         "pool on the same cores); each library at its own default integrator and steps unless the "
-        "scene says +xpbd12 (both at XPBD, 12 steps per frame). \"before\" is the build of the "
-        "commit before the contact stage, run on the first 12 frames (falling and landing). Error: "
+        "scene says +xpbd12 (both at XPBD, 12 steps per frame). "
+        + ("\"before\" is the build of the commit before the contact stage, run on the first 12 "
+           "frames (falling and landing). " if base else
+           "This run had no build of the commit before the contact stage (--contacts-base): its "
+           "\"before\" columns are empty. ") +
+        "Error: "
         "RMS over particles and frames of the distance to the same setting at 8x the steps, / the "
         "cloth's width; Blender's against its quality 40. Ranges are over alternated runs. Command: "
         f"`{' '.join(os.path.relpath(c, ROOT) if os.path.isabs(c) and c.startswith(ROOT) else c for c in cmd[1:])}` "
