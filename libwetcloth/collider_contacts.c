@@ -329,36 +329,6 @@ static int test_triangle(particle_run *run, const wc_collider *col, int32_t t, d
  * their turn. After a push the particle has moved, so the items after the
  * one that pushed are gathered again with the new bound. */
 
-/* Positions in owner k's list (ascending by item) of the items after
- * `after` whose bound is within reach (all of them when `all`), into out
- * (up to capacity); returns how many (which may exceed capacity). */
-static int32_t survivors(const wc_pair_lists *l, int32_t k, double reach, int all, int32_t after,
-                         int32_t *out, int32_t capacity)
-{
-    if (l->count[k] == 0) return 0; /* (the pool may not exist yet) */
-    const int32_t *item = l->item + l->start[k];
-    const double *d = l->d + l->start[k];
-    int32_t n = 0;
-    if (l->count[k] <= capacity) {
-        /* Room for every item: each position is written and counted if it
-         * is kept, without a branch. Which items the filter keeps changes
-         * from visit to visit, and the branch that skipped them was
-         * mispredicted often enough to make this scan a tenth of a dense
-         * collider's whole step. */
-        for (int32_t j = 0; j < l->count[k]; ++j) {
-            out[n] = j;
-            n += (item[j] > after) & (all | !(d[j] > reach));
-        }
-        return n;
-    }
-    for (int32_t j = 0; j < l->count[k]; ++j) {
-        if (item[j] <= after || (!all && d[j] > reach)) continue;
-        if (n < capacity) out[n] = j;
-        ++n;
-    }
-    return n;
-}
-
 /* Gathers position j of a list into out if its bound d is within `bound`,
  * and otherwise lowers *least to d; returns the new count. */
 static int32_t gather_one(int32_t j, double d, double bound, int32_t *out, int32_t n, double *least)
@@ -370,14 +340,16 @@ static int32_t gather_one(int32_t j, double d, double bound, int32_t *out, int32
     return n + keep;
 }
 
-/* The same for an element's list, whose scratch has room for all of it:
- * the positions of the items after `after` with d within `bound` (the
- * reach plus the owner's debt), and into *rest the least d of the others
- * (INFINITY if none): what a renewal needs to know of the items it does not
- * measure. */
-static int32_t element_survivors(const wc_pair_lists *l, int32_t k, double bound, int all,
-                                 int32_t after, int32_t *out, double *rest)
+/* Positions in owner k's list (ascending by item) of the items after
+ * `after` whose bound d is within `bound` (all of them when `all`), into out,
+ * which has room for the whole list; returns how many. *rest gets the least
+ * d of the items after `after` that were not gathered (INFINITY if none):
+ * what a renewal needs to know of the items it does not measure. */
+static int32_t survivors(const wc_pair_lists *l, int32_t k, double bound, int all, int32_t after,
+                         int32_t *out, double *rest)
 {
+    *rest = INFINITY;
+    if (l->count[k] == 0) return 0; /* (the pool may not exist yet) */
     const int32_t *item = l->item + l->start[k];
     const double *d = l->d + l->start[k];
     int32_t n = 0, count = l->count[k], j = 0;
@@ -403,7 +375,8 @@ static int32_t element_survivors(const wc_pair_lists *l, int32_t k, double bound
     double least = INFINITY;
     for (; j < count; ++j) {
         if (item[j] <= after) continue;
-        n = all ? (out[n] = j, n + 1) : gather_one(j, d[j], bound, out, n, &least);
+        if (all) out[n++] = j;
+        else n = gather_one(j, d[j], bound, out, n, &least);
     }
     *rest = least;
     return n;
@@ -460,10 +433,8 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
             moved |= direct_triangles(run, col, r, after);
             break;
         }
-        double reach = r + d + drift + FILTER_EPSILON(r);
-        int32_t n = survivors(l, i, reach, !use_filter, after, kept, room);
-        if (n > room) {
-            /* More survivors than the stack holds: a UV sphere's pole
+        if (l->count[i] > room) {
+            /* A longer list than the stack holds: a UV sphere's pole
              * gathers hundreds of slivers within r of a particle. Room for
              * the whole list is still far cheaper than asking the tree for
              * the motion's box, which finds more of them, unsorted (the
@@ -475,9 +446,10 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
             }
             if (kept != stack) wci_free(kept);
             kept = grown, room = l->count[i];
-            n = survivors(l, i, reach, !use_filter, after, kept, room);
         }
-        if (n == 0) break; /* (the pool may not exist yet) */
+        double reach = r + d + drift + FILTER_EPSILON(r), rest;
+        int32_t n = survivors(l, i, reach, !use_filter, after, kept, &rest);
+        if (n == 0) break;
         const int32_t *item = l->item + l->start[i];
         int32_t pushed = -1;
         for (int32_t j = 0; j < n && pushed < 0; ++j)
@@ -659,7 +631,7 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
         double motion = 0.0;
         for (int j = 0; j < kind->count; ++j)
             if (s->motion[idx[j]] > motion) motion = s->motion[idx[j]];
-        n = element_survivors(l, e, reach + drift + l->debt[e], !s->use_filter, after, s->kept, &rest);
+        n = survivors(l, e, reach + drift + l->debt[e], !s->use_filter, after, s->kept, &rest);
         int32_t hit = -1;
         for (int32_t j = 0; j < n && hit < 0; ++j) {
             int32_t f = l->item[l->start[e] + s->kept[j]];
