@@ -61,6 +61,13 @@ struct wc_implicit_state {
     double *partial;
     /// Per link, scratch of the product with the matrix: B (in_a - in_b).
     double *link_product;
+    /// The links whose block is not zero in this step (a slack stretch link
+    /// without a dashpot, a bend link that is not compressed: about half of
+    /// a draped cloth's), in index order, and per particle the entries of
+    /// its link list (cloth.h) that refer to them, in the list's order, at
+    /// the list's own offsets (`row_count` of them). The product visits only
+    /// these: the others would add exact zeros.
+    int32_t *active, active_count, *row_list, *row_count;
     /// The preconditioner's coarse levels; NULL for a cloth too small to
     /// gain from them (multigrid.h).
     wc_multigrid *multigrid;
@@ -77,6 +84,9 @@ void wci_implicit_state_destroy(wc_implicit_state *s)
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wci_free(arrays[i]);
     wci_free(s->end_a);
     wci_free(s->end_b);
+    wci_free(s->active);
+    wci_free(s->row_list);
+    wci_free(s->row_count);
     wci_multigrid_destroy(s->multigrid);
     wci_free(s);
 }
@@ -103,8 +113,11 @@ wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
         ok &= (*vectors[i] = wci_alloc_array(3 * n, sizeof(double))) != NULL;
     s->partial = wci_alloc_array(PARTIAL_SETS * (size_t)s->blocks, sizeof(double));
     s->link_product = wci_alloc_array(3 * links + 1, sizeof(double));
+    s->active = wci_alloc_array(links + 1, sizeof *s->active);
+    s->row_list = wci_alloc_array((size_t)c->link_start[n] + 1, sizeof *s->row_list);
+    s->row_count = wci_alloc_array(n + 1, sizeof *s->row_count);
     if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
-        !s->partial || !s->link_product) {
+        !s->partial || !s->link_product || !s->active || !s->row_list || !s->row_count) {
         wci_implicit_state_destroy(s);
         return NULL;
     }
@@ -213,6 +226,39 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
         set_block(blk, hh * along + h * damp, hh * across, ux, uy, uz);
     }
     return 0;
+}
+
+static int block_is_zero(const double *b)
+{
+    return b[0] == 0.0 && b[1] == 0.0 && b[2] == 0.0 && b[3] == 0.0 && b[4] == 0.0 && b[5] == 0.0;
+}
+
+/* Each particle's entries of the links with a block, in its list's order. */
+static int rows_range(void *context, int64_t begin, int64_t end)
+{
+    const implicit_pass *pass = context;
+    const wc_cloth *c = pass->cloth;
+    wc_implicit_state *s = pass->state;
+    for (int64_t i = begin; i < end; ++i) {
+        int32_t *row = s->row_list + c->link_start[i], count = 0;
+        for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
+            int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
+            if (!block_is_zero(s->block + 6 * (size_t)e)) row[count++] = entry;
+        }
+        s->row_count[i] = count;
+    }
+    return 0;
+}
+
+/* The links the product visits (the state's `active`), after the blocks. */
+static void active_links(const implicit_pass *pass, int threads)
+{
+    wc_implicit_state *s = pass->state;
+    int32_t count = 0;
+    for (int32_t e = 0; e < s->links; ++e)
+        if (!block_is_zero(s->block + 6 * (size_t)e)) s->active[count++] = e;
+    s->active_count = count;
+    wci_parallel_for(s->n, wc_threads_for(s->n, threads), rows_range, (void *)pass);
 }
 
 /* Start velocity (as forces.c computes it) and, for pins, the known change
@@ -334,7 +380,8 @@ static int link_products_range(void *context, int64_t begin, int64_t end)
     const implicit_pass *pass = context;
     wc_implicit_state *s = pass->state;
     const double *in = pass->in;
-    for (int64_t e = begin; e < end; ++e) {
+    for (int64_t k = begin; k < end; ++k) {
+        int32_t e = s->active[k];
         const double *va = in + 3 * (size_t)s->end_a[e], *vb = in + 3 * (size_t)s->end_b[e];
         wc_sym3_times(s->block + 6 * (size_t)e, va[0] - vb[0], va[1] - vb[1], va[2] - vb[2],
                       s->link_product + 3 * (size_t)e);
@@ -366,8 +413,9 @@ static int apply_range(void *context, int64_t first, int64_t last)
             const double *vi = in + 3 * (size_t)i;
             double md = s->mass_diag[i];
             double ox = md * vi[0], oy = md * vi[1], oz = md * vi[2];
-            for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
-                int32_t entry = c->link_list[k];
+            const int32_t *row = s->row_list + c->link_start[i];
+            for (int32_t k = 0; k < s->row_count[i]; ++k) {
+                int32_t entry = row[k];
                 if (entry >= 0) {
                     const double *t = s->link_product + 3 * (size_t)entry;
                     ox += t[0], oy += t[1], oz += t[2];
@@ -572,7 +620,7 @@ static void solve_body(void *context, const wc_team *team)
         double rz = precondition(&pass, team, 1, pass.r, NULL, 0.0);
         double decrease[ESTIMATE_DELAY] = {0.0};
         int64_t link_begin, link_end;
-        wc_team_slice(team, s->links, team->threads > 1, &link_begin, &link_end);
+        wc_team_slice(team, s->active_count, team->threads > 1, &link_begin, &link_end);
         pass.in = s->p, pass.out = s->q;
         for (; it < CG_MAX_ITERATIONS && rr > CG_TOLERANCE * CG_TOLERANCE * bb; ++it) {
             if (bound > 0.0 && it >= ESTIMATE_DELAY && sum_of(decrease, ESTIMATE_DELAY) <= bound)
@@ -689,6 +737,7 @@ int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doub
                           NULL, NULL, 0.0, NULL, NULL, NULL, NULL, NULL};
     wci_parallel_for(n, particle_threads, start_velocities_range, &pass);
     wci_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
+    active_links(&pass, threads);
     wci_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);
     int32_t bad = first_non_finite_rhs(s);
     if (bad >= 0) return bad;
