@@ -230,6 +230,50 @@ int32_t wci_bvh_query(const wc_bvh *b, const double box[6], int32_t *out, int32_
     return found;
 }
 
+void wci_bvh_fold_max(const wc_bvh *b, const double *item_values, double *node_values)
+{
+    /* children come after their parent (wci_bvh_create) */
+    for (int32_t k = b->node_count - 1; k >= 0; --k) {
+        const wc_bvh_node *node = b->nodes + k;
+        double most = 0.0;
+        if (node->count == 0) {
+            double l = node_values[node->first], r = node_values[node->first + 1];
+            most = l > r ? l : r;
+        } else {
+            for (int32_t j = 0; j < node->count; ++j) {
+                double v = item_values[b->order[node->first + j]];
+                if (v > most) most = v;
+            }
+        }
+        node_values[k] = most;
+    }
+}
+
+double wci_bvh_most_within(const wc_bvh *b, const double *item_values, const double *node_values,
+                           const double box[6])
+{
+    if (b->node_count == 0) return 0.0;
+    int32_t stack[STACK_DEPTH], depth = 0;
+    double most = 0.0;
+    stack[depth++] = 0;
+    while (depth > 0) {
+        int32_t k = stack[--depth];
+        const wc_bvh_node *node = b->nodes + k;
+        if (!(node_values[k] > most) || !overlap(node->box, box)) continue;
+        if (node->count == 0) {
+            stack[depth++] = node->first + 1;
+            stack[depth++] = node->first;
+            continue;
+        }
+        for (int32_t j = 0; j < node->count; ++j) {
+            int32_t item = b->order[node->first + j];
+            if (item_values[item] > most && overlap(b->boxes + 6 * (size_t)item, box))
+                most = item_values[item];
+        }
+    }
+    return most;
+}
+
 double wci_bvh_root_distance(const wc_bvh *b, const double p[3])
 {
     if (b->node_count == 0) return INFINITY;

@@ -64,6 +64,17 @@ int32_t wci_bvh_query(const wc_bvh *bvh, const double box[6], int32_t *out, int3
 /// they keep of it themselves.
 int32_t wci_bvh_collect(const wc_bvh *bvh, const double box[6], int32_t *out, int32_t capacity);
 
+/// After the items' values changed: each node's value becomes the largest
+/// of its items' (`item_values` per item, `node_values` per node, >= 0).
+void wci_bvh_fold_max(const wc_bvh *bvh, const double *item_values, double *node_values);
+
+/// The largest value of the items whose boxes overlap `box` (0 if none),
+/// with the node values that wci_bvh_fold_max made from the same item
+/// values: a branch and bound that skips every node whose value cannot
+/// raise the answer.
+double wci_bvh_most_within(const wc_bvh *bvh, const double *item_values, const double *node_values,
+                           const double box[6]);
+
 /// Distance from point p to the tree's root box (0 inside it; +inf for an
 /// empty tree): no item is nearer.
 double wci_bvh_root_distance(const wc_bvh *bvh, const double p[3]);

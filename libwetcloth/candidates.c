@@ -37,6 +37,7 @@ static void lists_free(wc_pair_lists *l)
 void wci_candidates_destroy(wc_candidates *c)
 {
     wci_free(c->base), wci_free(c->margin), wci_free(c->base_path);
+    wci_free(c->local_path), wci_free(c->local_step), wci_free(c->particle_mark);
     lists_free(&c->particles), lists_free(&c->triangles), lists_free(&c->edges);
     wci_free(c->vertex_seen), wci_free(c->edge_seen), wci_free(c->found), wci_free(c->gathered), wci_free(c->gathered_d0);
     memset(c, 0, sizeof *c);
@@ -384,7 +385,7 @@ static void rebase_one(wc_candidates *c, const wc_collider *col, int32_t i,
     if (!(m > now)) m = now + MARGIN_LOW * r + 1e-12;
     c->base[3 * (size_t)i] = p[0], c->base[3 * (size_t)i + 1] = p[1], c->base[3 * (size_t)i + 2] = p[2];
     c->margin[i] = m;
-    c->base_path[i] = col->path;
+    c->base_path[i] = c->local_path[i];
 }
 
 static int allocate(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col)
@@ -394,6 +395,10 @@ static int allocate(wc_candidates *c, const wc_cloth_elements *el, const wc_coll
     if (!c->base) c->base = wci_alloc_array(3 * n, sizeof *c->base);
     if (!c->margin) c->margin = wci_alloc_array(n, sizeof *c->margin);
     if (!c->base_path) c->base_path = wci_alloc_array(n, sizeof *c->base_path);
+    if (!c->local_path) c->local_path = wci_alloc_array(n, sizeof *c->local_path);
+    if (!c->local_step) c->local_step = wci_alloc_array(n, sizeof *c->local_step);
+    if (!c->particle_mark) c->particle_mark = wci_alloc_array(n, 1);
+    if (!c->base_path || !c->local_path || !c->local_step || !c->particle_mark) return 0;
     if (!c->vertex_seen) c->vertex_seen = wci_alloc_array((size_t)col->vertex_count, 1);
     if (!c->edge_seen) c->edge_seen = wci_alloc_array((size_t)col->edge_count + 1, 1);
     return c->base && c->margin && c->base_path && c->vertex_seen && c->edge_seen;
@@ -409,15 +414,19 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
     c->r = r;
     scratch s = {NULL, 0};
     int ok = 1;
+    for (int32_t i = 0; i < el->particle_count; ++i) c->local_path[i] = 0.0, c->local_step[i] = 0.0;
     for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, i, p, steps_left);
     for (int32_t i = 0; i < el->particle_count && ok; ++i) ok = particle_list(c, &s, col, bvh, i);
-    for (int32_t t = 0; t < el->triangle_count && ok; ++t) ok = triangle_list(c, &s, el, col, bvh, t, col->path);
-    for (int32_t e = 0; e < el->edge_count && ok; ++e) ok = edge_list(c, &s, el, col, bvh, e, col->path);
+    for (int32_t t = 0; t < el->triangle_count && ok; ++t)
+        ok = triangle_list(c, &s, el, col, bvh, t, c->local_path[el->triangles[3 * (size_t)t]]);
+    for (int32_t e = 0; e < el->edge_count && ok; ++e)
+        ok = edge_list(c, &s, el, col, bvh, e, c->local_path[el->edges[2 * (size_t)e]]);
     wci_free(s.e);
     if (!ok) {
         c->r = 0.0; /* made again at the next use */
         return WC_ERROR_OUT_OF_MEMORY;
     }
+    wci_candidates_local_motion(c, el, col, NULL, el->particle_count);
     return WC_OK;
 }
 
@@ -439,8 +448,9 @@ wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, c
                 int32_t e = items[j];
                 if (mark[e]) continue;
                 mark[e] = 1;
-                ok = kind ? edge_list(c, &s, el, col, bvh, e, col->path)
-                          : triangle_list(c, &s, el, col, bvh, e, col->path);
+                int32_t first = kind ? el->edges[2 * (size_t)e] : el->triangles[3 * (size_t)e];
+                ok = kind ? edge_list(c, &s, el, col, bvh, e, c->local_path[first])
+                          : triangle_list(c, &s, el, col, bvh, e, c->local_path[first]);
             }
         for (int32_t k = 0; k < count; ++k)
             for (int32_t j = start[particles[k]]; j < start[particles[k] + 1]; ++j) mark[items[j]] = 0;
@@ -450,7 +460,91 @@ wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, c
         c->r = 0.0;
         return WC_ERROR_OUT_OF_MEMORY;
     }
+    /* new bases and margins: their reaches and their neighbours' */
+    wci_candidates_local_motion(c, el, col, particles, count);
     return WC_OK;
+}
+
+/* The half-side of particle i's cube (wci_candidates_local_motion). */
+static double local_reach(const wc_candidates *c, const wc_cloth_elements *el, int32_t i)
+{
+    double margin = c->margin[i], far2 = 0.0, b[3], q[3];
+    base_of(c, i, b);
+    for (int32_t k = el->edges_start[i]; k < el->edges_start[i + 1]; ++k) {
+        const int32_t *e = el->edges + 2 * (size_t)el->edges_of[k];
+        int32_t j = e[0] == i ? e[1] : e[0];
+        if (c->margin[j] > margin) margin = c->margin[j];
+        base_of(c, j, q);
+        double d[3] = {q[0] - b[0], q[1] - b[1], q[2] - b[2]};
+        double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        if (d2 > far2) far2 = d2;
+    }
+    return c->r + margin + sqrt(far2);
+}
+
+static void local_motion_of(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                            int32_t i)
+{
+    if (!(col->step_motion > 0.0) || c->whole_collider) {
+        c->local_step[i] = col->step_motion;
+        return;
+    }
+    double b[3], reach = local_reach(c, el, i), box[6];
+    base_of(c, i, b);
+    for (int k = 0; k < 3; ++k) box[k] = b[k] - reach, box[k + 3] = b[k] + reach;
+    c->local_step[i] = wci_bvh_most_within(&col->bvh, col->triangle_motion, col->node_motion, box);
+}
+
+void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el,
+                                 const wc_collider *col, const int32_t *particles, int32_t count)
+{
+    if (!particles) {
+        for (int32_t i = 0; i < el->particle_count; ++i) local_motion_of(c, el, col, i);
+        return;
+    }
+    /* each listed particle and each neighbour once, in the order met */
+    int32_t seen = 0;
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t i = particles[k];
+        for (int32_t m = el->edges_start[i] - 1; m < el->edges_start[i + 1]; ++m) {
+            int32_t j = i;
+            if (m >= el->edges_start[i]) {
+                const int32_t *e = el->edges + 2 * (size_t)el->edges_of[m];
+                j = e[0] == i ? e[1] : e[0];
+            }
+            if (c->particle_mark[j]) continue;
+            c->particle_mark[j] = 1, ++seen;
+            local_motion_of(c, el, col, j);
+        }
+    }
+    for (int32_t k = 0; k < count && seen; ++k) {
+        int32_t i = particles[k];
+        c->particle_mark[i] = 0;
+        for (int32_t m = el->edges_start[i]; m < el->edges_start[i + 1]; ++m) {
+            const int32_t *e = el->edges + 2 * (size_t)el->edges_of[m];
+            c->particle_mark[e[0]] = 0, c->particle_mark[e[1]] = 0;
+        }
+    }
+}
+
+void wci_candidates_commit(wc_candidates *c, int32_t particle_count)
+{
+    if (!c->local_path) return;
+    for (int32_t i = 0; i < particle_count; ++i) c->local_path[i] += c->local_step[i], c->local_step[i] = 0.0;
+}
+
+double wci_candidates_ceiling(const wc_candidates *c, const int32_t *idx, int count,
+                              const wc_particle_arrays *p)
+{
+    double far2 = 0.0;
+    for (int k = 0; k < count; ++k) {
+        int32_t i = idx[k];
+        const double *b = c->base + 3 * (size_t)i;
+        double d[3] = {p->nx[i] - b[0], p->ny[i] - b[1], p->nz[i] - b[2]};
+        double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        if (d2 > far2) far2 = d2;
+    }
+    return c->r + element_margin(c, idx, count) - sqrt(far2);
 }
 
 /* The larger distance of particle i at the start and at the end of the
@@ -498,12 +592,13 @@ double wci_pair_lists_end_drift(const wc_pair_lists *l, int32_t k, const int32_t
 void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
                          const wc_particle_arrays *p, double collider_path, const int32_t *at,
                          const double *measured2, int32_t n, double least_unmeasured,
-                         double drift_end)
+                         double drift_end, double ceiling)
 {
     double *d = l->d + l->start[k], debt = l->debt[k] + drift_end, least = least_unmeasured;
     l->debt[k] = debt;
     for (int32_t j = 0; j < n; ++j) {
-        d[at[j]] = sqrt(measured2[j]) + debt;
+        double measured = sqrt(measured2[j]);
+        d[at[j]] = (measured < ceiling ? measured : ceiling) + debt;
         if (d[at[j]] < least) least = d[at[j]];
     }
     l->least[k] = least;

@@ -19,9 +19,9 @@
  * each corner by at most D moves every point of it by at most D, and a
  * distance is 1-Lipschitz in each point. Let D_p be the largest distance of
  * the owner's particles from their base positions at the start and at the
- * end of the step, and D_c how far any collider vertex can have moved since
- * the list was made (the collider's path: the sum over steps of its largest
- * vertex displacement). Motion within a step is linear and the norm convex,
+ * end of the step, and D_c how far the collider's features near the owner
+ * can have moved since the list was made (its local path, below). Motion
+ * within a step is linear and the norm convex,
  * so at every time of the step the particles are within D_p of their bases.
  * Then at every time of the step
  *     distance >= d0 - D_p - D_c.
@@ -35,6 +35,33 @@
  * that is rebased: new base, new margin, and its lists and those of its
  * triangles and edges are made again before they are used. The survivors
  * get the exact test: continuous where the pair can cross (narrowphase.c).
+ *
+ * Local motion. A deforming collider moves more in some places than in
+ * others (a character's arm swings while the cloth rests on its back), so
+ * D_c counts only the collider near the owner. At each step, particle i's
+ * local step is the largest displacement of the collider triangles whose
+ * boxes meet the cube of half-side T_i = r + (the largest margin of i and
+ * its neighbours) + (its farthest neighbour's distance) around its base;
+ * its local path sums them over the committed steps, and D_c for a list is
+ * the difference of the local paths of its owner (of its first particle,
+ * for a triangle or an edge) between now and when the list was made or
+ * renewed. Why that suffices: call a triangle near at a step when its box
+ * meets the cube. A triangle that is not near is farther than r + M from
+ * the particle's base, and from every point of the particle's triangles
+ * and edges at their bases (the cube reaches their farthest corner plus
+ * their margins), so while the particle keeps D_p + D_c < M nothing of it
+ * can touch the owner during that step. By induction over the steps, the
+ * distance of any feature from the owner at its base is then at least
+ * min(d0, r + M) less the local motion summed over the steps at which its
+ * triangle was near, which is at most D_c: the argument above holds with
+ * the local path in place of the collider's. A snapshot (below) credits
+ * a measured pair with at most r + M - D (D the farthest of the owner's
+ * particles from their bases at the snapshot), the distance that a
+ * feature not near at a later step is known to keep from the snapshot, so
+ * that a bound carried over renewals stays a bound. The cube is found by
+ * a branch and bound over the collider's tree (broadphase.h); a still
+ * collider costs nothing. A rebase changes bases and margins, so it makes
+ * the local steps of the rebased particles and their neighbours again.
  */
 #ifndef WC_CANDIDATES_H
 #define WC_CANDIDATES_H
@@ -89,9 +116,19 @@ typedef struct wc_pair_lists {
 typedef struct wc_candidates {
     /// Contact distance the lists were made for; 0 until made.
     double r;
-    /// Per particle: base position (xyz), margin, and the collider's path
-    /// at its last rebase.
+    /// Per particle: base position (xyz), margin, and its local path at its
+    /// last rebase.
     double *base, *margin, *base_path;
+    /// Per particle: its local path (summed over the committed steps, the
+    /// largest displacement of the collider's triangles near it in each)
+    /// and that displacement in the step being computed (see the local
+    /// motion above).
+    double *local_path, *local_step;
+    /// Scratch per particle (zero between calls).
+    uint8_t *particle_mark;
+    /// A test's switch: every particle's local motion is the collider's
+    /// largest (its step motion), as if the whole collider were near.
+    int whole_collider;
     wc_pair_lists particles, triangles, edges;
     /// Scratch: collider vertices and edges already gathered for one owner.
     uint8_t *vertex_seen, *edge_seen;
@@ -115,22 +152,47 @@ typedef struct wc_cloth_elements {
 /// leaves it zeroed, empty again.
 void wci_candidates_destroy(wc_candidates *cand);
 
-/// Whether particle i, at displacement `d` from its base with the collider
-/// at `path`, is still covered by its lists: what is unlisted stays beyond
-/// reach.
-static inline int wc_candidates_covers(const wc_candidates *cand, int32_t i, double d, double path)
+/// Particle i's local path by the end of the step being computed.
+static inline double wc_candidates_path_now(const wc_candidates *cand, int32_t i)
 {
-    return d + (path - cand->base_path[i]) < cand->margin[i];
+    return cand->local_path[i] + cand->local_step[i];
+}
+
+/// Whether particle i, at displacement `d` from its base, is still covered
+/// by its lists: what is unlisted stays beyond reach.
+static inline int wc_candidates_covers(const wc_candidates *cand, int32_t i, double d)
+{
+    return d + (wc_candidates_path_now(cand, i) - cand->base_path[i]) < cand->margin[i];
 }
 
 /// Whether particle i has used more than half its margin: the stage rebases
 /// such particles together before a step, so that neighbours moving
 /// together are rebased in the same step and the lists of their shared
 /// triangles and edges are made once rather than once per particle.
-static inline int wc_candidates_half_used(const wc_candidates *cand, int32_t i, double d, double path)
+static inline int wc_candidates_half_used(const wc_candidates *cand, int32_t i, double d)
 {
-    return d + (path - cand->base_path[i]) >= 0.5 * cand->margin[i];
+    return d + (wc_candidates_path_now(cand, i) - cand->base_path[i]) >= 0.5 * cand->margin[i];
 }
+
+/// This step's local motion (local_step) of the `count` particles listed,
+/// or of every particle when `particles` is NULL, and of their neighbours
+/// (a particle's reach takes its neighbours' margins and bases): the
+/// largest displacement in this step of the collider's triangles whose
+/// boxes meet the cube of half-side r + (the largest margin of the particle
+/// and its neighbours) + (its farthest neighbour's distance) around its
+/// base. 0 for a collider that stands still.
+void wci_candidates_local_motion(wc_candidates *cand, const wc_cloth_elements *el,
+                                 const wc_collider *col, const int32_t *particles, int32_t count);
+
+/// After a committed step: every particle's local step added to its path.
+void wci_candidates_commit(wc_candidates *cand, int32_t particle_count);
+
+/// The most a renewed snapshot of the element with particles idx[0 ..
+/// count) may credit a pair with: r + M - D, M the largest margin of its
+/// particles, D the farthest of their ends from their bases (see the local
+/// motion above).
+double wci_candidates_ceiling(const wc_candidates *cand, const int32_t *idx, int count,
+                              const wc_particle_arrays *p);
 
 /// Particle i's distance from its base: the larger at the start (x) and at
 /// the end (nx) of the step, which by convexity bounds it over the step.
@@ -165,13 +227,15 @@ double wci_pair_lists_end_drift(const wc_pair_lists *l, int32_t k, const int32_t
 /// After a visit of owner k that moved nothing: its snapshot renewed at its
 /// particles' present ends and the collider's end of step. The items at
 /// positions at[0 .. n) were measured, at squared distances measured2[0 ..
-/// n); the others keep their bound less `drift_end` (how far owner and
-/// collider can have moved from the old snapshot to now), and the least of
-/// their d is `least_unmeasured` (INFINITY if none).
+/// n), each credited with at most `ceiling` (wci_candidates_ceiling); the
+/// others keep their bound less `drift_end` (how far owner and collider can
+/// have moved from the old snapshot to now), and the least of their d is
+/// `least_unmeasured` (INFINITY if none). `collider_path` is the local path
+/// that the owner's drift is measured against, now.
 void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
                          const wc_particle_arrays *p, double collider_path, const int32_t *at,
                          const double *measured2, int32_t n, double least_unmeasured,
-                         double drift_end);
+                         double drift_end, double ceiling);
 
 /// Distance from a point to a collider triangle, vertex and edge in the
 /// collider's current positions (what the lists' d0 are measured in).

@@ -47,6 +47,9 @@ void wci_collider_destroy(wc_collider *c)
     wci_free(c->next);
     wci_free(c->boxes);
     wci_free(c->normals);
+    wci_free(c->vertex_motion);
+    wci_free(c->triangle_motion);
+    wci_free(c->node_motion);
     wci_bvh_destroy(&c->bvh);
     wci_convex_shape_destroy(&c->convex);
     wci_free(c);
@@ -337,6 +340,34 @@ static void static_normals(wc_collider *c)
     c->normals_current = 1;
 }
 
+/* This step's displacement per vertex, per triangle and per node of the
+ * tree (the tree's boxes span the advance, so they hold the step's), and
+ * the largest of all: the step motion. */
+static wc_status step_motions(wc_collider *c)
+{
+    if (!c->vertex_motion) c->vertex_motion = wci_alloc_array((size_t)c->vertex_count + 1, sizeof(double));
+    if (!c->triangle_motion) c->triangle_motion = wci_alloc_array((size_t)c->triangle_count + 1, sizeof(double));
+    if (!c->node_motion) c->node_motion = wci_alloc_array(2 * (size_t)c->triangle_count + 1, sizeof(double));
+    if (!c->vertex_motion || !c->triangle_motion || !c->node_motion) return WC_ERROR_OUT_OF_MEMORY;
+    double most = 0.0;
+    for (int32_t v = 0; v < c->vertex_count; ++v) {
+        const double *a = c->current + 3 * (size_t)v, *b = c->next + 3 * (size_t)v;
+        double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        c->vertex_motion[v] = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (c->vertex_motion[v] > most) most = c->vertex_motion[v];
+    }
+    for (int32_t t = 0; t < c->triangle_count; ++t) {
+        const int32_t *v = c->triangles + 3 * (size_t)t;
+        double m = c->vertex_motion[v[0]];
+        if (c->vertex_motion[v[1]] > m) m = c->vertex_motion[v[1]];
+        if (c->vertex_motion[v[2]] > m) m = c->vertex_motion[v[2]];
+        c->triangle_motion[t] = m;
+    }
+    wci_bvh_fold_max(&c->bvh, c->triangle_motion, c->node_motion);
+    c->step_motion = most;
+    return WC_OK;
+}
+
 static wc_status mesh_begin_step(wc_collider *c, double share)
 {
     size_t nv = 3 * (size_t)c->vertex_count;
@@ -345,16 +376,9 @@ static wc_status mesh_begin_step(wc_collider *c, double share)
         if (share >= 1.0) memcpy(c->next, c->target, nv * sizeof *c->next); /* exactly there */
         else
             for (size_t k = 0; k < nv; ++k) c->next[k] = wc_lerp(c->current[k], c->target[k], share);
-        double most2 = 0.0;
-        for (size_t v = 0; v < nv; v += 3) {
-            double d[3] = {c->next[v] - c->current[v], c->next[v + 1] - c->current[v + 1],
-                           c->next[v + 2] - c->current[v + 2]};
-            double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            if (d2 > most2) most2 = d2;
-        }
-        c->step_motion = sqrt(most2);
     }
     if (!c->indexed && index_mesh(c)) return WC_ERROR_OUT_OF_MEMORY;
+    if (c->moving && step_motions(c)) return WC_ERROR_OUT_OF_MEMORY;
     if (!c->moving && !c->normals_current) static_normals(c);
     return WC_OK;
 }

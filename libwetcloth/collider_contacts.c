@@ -34,7 +34,7 @@ struct wc_collider_contacts {
     /// Per collider (by index): the candidates; made at first use.
     wc_candidates *cand;
     int32_t cand_count;
-    int use_filter;
+    int use_filter, whole_collider;
     /// Between rounds: recheck (the particle pass must test the particle
     /// again) and shifted (the feature pass must visit its elements).
     uint8_t *recheck, *shifted;
@@ -194,7 +194,14 @@ void wci_collider_contacts_destroy(wc_collider_contacts *s)
     wci_free(s);
 }
 
+void wci_collider_contacts_commit(wc_collider_contacts *s, int32_t particle_count)
+{
+    for (int32_t k = 0; k < s->cand_count; ++k) wci_candidates_commit(&s->cand[k], particle_count);
+}
+
 void wci_collider_contacts_use_filter(wc_collider_contacts *s, int use) { s->use_filter = use; }
+
+void wci_collider_contacts_use_local_motion(wc_collider_contacts *s, int use) { s->whole_collider = !use; }
 
 int64_t wci_collider_contacts_feature_tests(const wc_collider_contacts *s) { return s->feature_tests; }
 
@@ -206,13 +213,6 @@ static double contact_distance(const wc_cloth *c, const wc_collider *col)
 {
     double r = c->material.thickness + col->thickness;
     return r < MIN_CONTACT_DISTANCE ? MIN_CONTACT_DISTANCE : r;
-}
-
-/* How far collider col can have moved since `path_at` by the end of the
- * step (candidates.h). */
-static double collider_drift(const wc_collider *col, double path_at)
-{
-    return col->path + col->step_motion - path_at;
 }
 
 static int grow_candidates(wc_collider_contacts *s, int32_t count)
@@ -259,15 +259,16 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         const wc_collider *col = colliders[k];
         if (!col->is_mesh) continue;
         wc_candidates *cand = &s->cand[k];
+        cand->whole_collider = s->whole_collider;
         double r = contact_distance(c, col);
         if (cand->r != r) {
             if (wci_candidates_update(cand, &s->el, col, r, p, steps_left))
                 return WC_ERROR_OUT_OF_MEMORY;
             continue;
         }
-        double path = col->path + col->step_motion;
+        wci_candidates_local_motion(cand, &s->el, col, NULL, c->particle_count);
         for (int32_t i = 0; i < c->particle_count; ++i)
-            if (wc_candidates_half_used(cand, i, wci_candidates_displacement(cand, p, i), path))
+            if (wc_candidates_half_used(cand, i, wci_candidates_displacement(cand, p, i)))
                 note_rebase(s, i);
         if (flush_rebase(s, col, k, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
     }
@@ -424,11 +425,11 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
     const wc_particle_arrays *p = run->p;
     const wc_pair_lists *l = &cand->particles;
     int32_t i = run->i, after = -1, stack[DIRECT_STACK], *kept = stack, room = DIRECT_STACK;
-    double path = col->path + col->step_motion, drift = collider_drift(col, l->path_at[i]);
+    double drift = wc_candidates_path_now(cand, i) - l->path_at[i];
     int moved = 0;
     for (;;) {
         double d = wci_candidates_displacement(cand, p, i);
-        if (!wc_candidates_covers(cand, i, d, path)) {
+        if (!wc_candidates_covers(cand, i, d)) {
             run->leaves_cover = 1;
             moved |= direct_triangles(run, col, r, after);
             break;
@@ -574,10 +575,9 @@ static wc_status note_pushed(wc_collider_contacts *s, const wc_particle_arrays *
     for (int32_t c = 0; c < count; ++c) {
         const wc_collider *col = colliders[c];
         if (!col->is_mesh) continue;
-        double path = col->path + col->step_motion;
         for (int j = 0; j < k->count; ++j)
             if (moved[j] && !wc_candidates_covers(&s->cand[c], k->particle[j],
-                                                  wci_candidates_displacement(&s->cand[c], p, k->particle[j]), path))
+                                                  wci_candidates_displacement(&s->cand[c], p, k->particle[j])))
                 note_rebase(s, k->particle[j]);
         if (flush_rebase(s, col, c, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
     }
@@ -618,8 +618,11 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
     const wc_collider *col = colliders[k];
     const int32_t *idx = kind->particles + (size_t)kind->count * (size_t)e;
     const wc_pair_lists *l = kind->lists;
+    const wc_candidates *cand = &s->cand[k];
     double reach = feature_reach(r) + FILTER_EPSILON(r);
-    double drift = wci_pair_lists_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
+    /* the collider's motion near the element counts at its first particle
+     * (candidates.h, local motion) */
+    double drift = wci_pair_lists_drift(l, e, idx, p) + (wc_candidates_path_now(cand, idx[0]) - l->path_at[e]);
     /* nothing in the list can touch: the cheap way out of most visits */
     if (!s->use_filter ? l->count[e] == 0 : l->least[e] - l->debt[e] - drift > reach) return 0;
     double mu = sqrt(c->material.friction * col->friction), rest = INFINITY;
@@ -655,15 +658,21 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
         if (hit < 0) break;
         pushed = 1, after = hit;
         /* the push moved the element (and perhaps rebased its list) */
-        drift = wci_pair_lists_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
+        drift = wci_pair_lists_drift(l, e, idx, p) + (wc_candidates_path_now(cand, idx[0]) - l->path_at[e]);
     }
     if (!pushed) {
         /* One gathering, every survivor measured at the ends as they are:
          * a fresh snapshot. (After a push the list may have been made again,
          * and what was measured before the push is of no use.) */
-        double end_drift = wci_pair_lists_end_drift(l, e, idx, p) + collider_drift(col, l->path_at[e]);
-        wci_pair_lists_renew((wc_pair_lists *)l, e, idx, p, col->path + col->step_motion, s->kept,
-                            s->measured, n, rest, end_drift);
+        double now = wc_candidates_path_now(cand, idx[0]), step = cand->local_step[idx[0]];
+        double end_drift = wci_pair_lists_end_drift(l, e, idx, p) + (now - l->path_at[e]);
+        /* The snapshot's collider is where this step takes it, and the step
+         * may yet be refused (a failed or tearing step) and taken again:
+         * counted from the committed path less this step's motion, the
+         * drift covers the collider from there as well as from where it
+         * really goes. */
+        wci_pair_lists_renew((wc_pair_lists *)l, e, idx, p, now - 2.0 * step, s->kept, s->measured, n, rest,
+                            end_drift, wci_candidates_ceiling(cand, idx, kind->count, p));
     }
     return pushed;
 }
@@ -794,10 +803,9 @@ static wc_status pass_rounds(wc_collider_contacts *s, wc_cloth *c, const wc_part
          * the feature pass and the next step */
         for (int32_t k = 0; k < count; ++k) {
             if (!colliders[k]->is_mesh) continue;
-            double path = colliders[k]->path + colliders[k]->step_motion;
             for (int32_t i = 0; i < c->particle_count; ++i)
                 if (s->shifted[i] &&
-                    !wc_candidates_covers(&s->cand[k], i, wci_candidates_displacement(&s->cand[k], p, i), path))
+                    !wc_candidates_covers(&s->cand[k], i, wci_candidates_displacement(&s->cand[k], p, i)))
                     note_rebase(s, i);
             if (flush_rebase(s, colliders[k], k, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
         }

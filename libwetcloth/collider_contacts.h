@@ -62,6 +62,15 @@ wc_status wci_collider_contacts_recheck(wc_cloth *cloth, wc_collider_contacts *s
 /// Test switch: 1 (default) skips the pairs the filter proves apart, 0
 /// gives every listed pair the exact test. The results are the same bit for
 /// bit; tests compare the two.
+/// After a committed step: the candidates' local paths take the step's
+/// local motion (candidates.h).
+void wci_collider_contacts_commit(wc_collider_contacts *state, int32_t particle_count);
+
+/// For tests: 0 bounds the collider's motion near every particle by its
+/// largest anywhere (the candidates' whole_collider); 1, the default, by
+/// what is near.
+void wci_collider_contacts_use_local_motion(wc_collider_contacts *state, int use);
+
 void wci_collider_contacts_use_filter(wc_collider_contacts *state, int use);
 
 /// How many exact tests of feature pairs (collider vertex against cloth

@@ -406,6 +406,8 @@ static void commit_stage(wc_world *w, const step_context *ctx)
             w->stats.stuck_particles += wci_wet_mark_stuck(w->cloths[c]);
     wci_particles_commit(&w->particles, w->cloths, w->cloth_count);
     for (int32_t c = 0; c < w->cloth_count; ++c) {
+        wc_cloth *cl = w->cloths[c];
+        if (cl->collider_contacts) wci_collider_contacts_commit(cl->collider_contacts, cl->particle_count);
         wci_cloth_commit(w->cloths[c], ctx->dt, ctx->colliding);
         w->cloths[c]->guard = w->cloths[c]->guard_next;
     }

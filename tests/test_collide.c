@@ -687,6 +687,98 @@ static void rest_on_a_pole(void)
     CHECK(filtered == all, "the filter changed the result on the pole");
 }
 
+
+/* A deforming ground, 48 x 48 quads over 1.6 m, with a 16 x 16 cloth of
+ * 0.5 m resting on its middle: the candidates bound the ground's motion near
+ * each particle by the triangles near it (candidates.h, local motion), not
+ * by the fastest vertex anywhere. `flap` (m) lifts and lowers the ground's
+ * far strip (x > 0.55) by up to that much a frame, far from the cloth;
+ * `bump` (m) raises a smooth bump under the cloth's middle over the run.
+ * Returns the feature tests of the last 12 frames and the final hash. */
+enum { GROUND_N = 48 };
+
+static void ground_vertices(double flap, double bump, double *v)
+{
+    for (int j = 0; j <= GROUND_N; ++j)
+        for (int i = 0; i <= GROUND_N; ++i) {
+            double x = -0.8 + 1.6 * i / GROUND_N, y = -0.8 + 1.6 * j / GROUND_N;
+            double z = x > 0.55 ? flap * (x - 0.55) / 0.25 : 0.0;
+            z += bump * exp(-(x * x + y * y) / (2 * 0.1 * 0.1));
+            double *p = v + 3 * (size_t)(j * (GROUND_N + 1) + i);
+            p[0] = x, p[1] = y, p[2] = z;
+        }
+}
+
+static int64_t deforming_ground(int local, double flap, double bump, uint64_t *hash)
+{
+    static double v[3 * (GROUND_N + 1) * (GROUND_N + 1)];
+    static int32_t t[6 * GROUND_N * GROUND_N];
+    int32_t nt = 0;
+    for (int j = 0; j < GROUND_N; ++j)
+        for (int i = 0; i < GROUND_N; ++i) {
+            int32_t a = j * (GROUND_N + 1) + i, b = a + 1, c = a + GROUND_N + 1, d = c + 1;
+            t[3 * nt] = a, t[3 * nt + 1] = b, t[3 * nt + 2] = d, ++nt;
+            t[3 * nt] = a, t[3 * nt + 1] = d, t[3 * nt + 2] = c, ++nt;
+        }
+    wc_world_def def = wc_world_def_default();
+    def.thread_count = 1;
+    wc_world *w = scene_world_from(&def);
+    ground_vertices(0.0, 0.0, v);
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertices = v, d.vertex_count = (GROUND_N + 1) * (GROUND_N + 1);
+    d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
+    int32_t col, cl;
+    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    wc_grid_cloth_def g = wc_grid_cloth_def_default();
+    g.count_u = g.count_v = 16;
+    g.size_u = g.size_v = 0.5;
+    g.center[2] = 0.05;
+    CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
+    int64_t before = 0;
+    for (int f = 0; f < 36; ++f) {
+        if (f >= 12) {
+            double s = (f - 11) / 24.0;
+            ground_vertices(flap * sin(3.0 * (f - 11)), bump * s, v);
+            CHECK(wc_collider_set_vertices(w, col, v, d.vertex_count) == WC_OK, "%s",
+                  wc_world_last_error(w));
+        }
+        advance_or_fail(w, 1.0 / 24, 0);
+        if (f == 0) wci_collider_contacts_use_local_motion(w->cloths[cl]->collider_contacts, local);
+        if (f == 23) before = wci_collider_contacts_feature_tests(w->cloths[cl]->collider_contacts);
+    }
+    CHECK(wc_world_get_stats(w).collider_contacts > 0, "the cloth is not on the ground");
+    int64_t tests = wci_collider_contacts_feature_tests(w->cloths[cl]->collider_contacts) - before;
+    *hash = scene_hash_positions(w, cl);
+    wc_world_destroy(w);
+    return tests;
+}
+
+/* The bound is exact where the ground moves under the cloth (a bump lifts
+ * it 4 cm while the far strip flaps 5 cm a frame): the same bits as with
+ * the whole ground's motion counted near every particle. And the flapping
+ * strip alone costs the resting cloth what a still ground does (no feature
+ * test over the last 12 frames, measured), where the whole ground's bound
+ * rebases it and tests its pairs at every step (about a million tests). */
+static void local_collider_motion(void)
+{
+    uint64_t local_hash, whole_hash, still_hash, flap_hash, flap_whole_hash;
+    deforming_ground(1, 0.05, 0.04, &local_hash);
+    deforming_ground(0, 0.05, 0.04, &whole_hash);
+    int64_t still = deforming_ground(1, 0.0, 0.0, &still_hash);
+    int64_t flap = deforming_ground(1, 0.05, 0.0, &flap_hash);
+    int64_t flap_whole = deforming_ground(0, 0.05, 0.0, &flap_whole_hash);
+    printf("deforming ground: bump %016llx (local) %016llx (whole); resting, frames 25-36: %lld "
+           "feature tests on a still ground, %lld with the far strip flapping, %lld with its "
+           "motion counted everywhere\n", (unsigned long long)local_hash,
+           (unsigned long long)whole_hash, (long long)still, (long long)flap, (long long)flap_whole);
+    CHECK(local_hash == whole_hash, "the local bound changed the result under a moving ground");
+    CHECK(flap_hash == flap_whole_hash, "the local bound changed the result beside a flapping strip");
+    CHECK(flap_whole > 0, "the whole ground's motion made no tests");
+    CHECK(20 * (flap - still) <= flap_whole,
+          "a far flapping strip costs the cloth tests: %lld, still %lld, whole bound %lld",
+          (long long)flap, (long long)still, (long long)flap_whole);
+}
+
 static double seconds(void)
 {
     return (double)clock() / CLOCKS_PER_SEC;
@@ -718,6 +810,8 @@ int main(void)
     filter_is_exact(WC_INTEGRATOR_XPBD, 20, "xpbd, 20 steps per frame");
     printf("(%.1f s) ", seconds() - t0);
     resting_pairs_skipped();
+    printf("(%.1f s) ", seconds() - t0);
+    local_collider_motion();
     printf("(%.1f s)\n", seconds() - t0);
     return test_report("test_collide");
 }
