@@ -465,14 +465,20 @@ wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, c
     return WC_OK;
 }
 
+/* The particle at the other end of particle i's k-th edge. */
+static int32_t neighbour(const wc_cloth_elements *el, int32_t i, int32_t k)
+{
+    const int32_t *e = el->edges + 2 * (size_t)el->edges_of[k];
+    return e[0] == i ? e[1] : e[0];
+}
+
 /* The half-side of particle i's cube (wci_candidates_local_motion). */
 static double local_reach(const wc_candidates *c, const wc_cloth_elements *el, int32_t i)
 {
     double margin = c->margin[i], far2 = 0.0, b[3], q[3];
     base_of(c, i, b);
     for (int32_t k = el->edges_start[i]; k < el->edges_start[i + 1]; ++k) {
-        const int32_t *e = el->edges + 2 * (size_t)el->edges_of[k];
-        int32_t j = e[0] == i ? e[1] : e[0];
+        int32_t j = neighbour(el, i, k);
         if (c->margin[j] > margin) margin = c->margin[j];
         base_of(c, j, q);
         double d[3] = {q[0] - b[0], q[1] - b[1], q[2] - b[2]};
@@ -502,28 +508,22 @@ void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el,
         for (int32_t i = 0; i < el->particle_count; ++i) local_motion_of(c, el, col, i);
         return;
     }
-    /* each listed particle and each neighbour once, in the order met */
-    int32_t seen = 0;
+    /* each listed particle and each neighbour once, in the order met (m =
+     * the start less one stands for the particle itself) */
     for (int32_t k = 0; k < count; ++k) {
         int32_t i = particles[k];
         for (int32_t m = el->edges_start[i] - 1; m < el->edges_start[i + 1]; ++m) {
-            int32_t j = i;
-            if (m >= el->edges_start[i]) {
-                const int32_t *e = el->edges + 2 * (size_t)el->edges_of[m];
-                j = e[0] == i ? e[1] : e[0];
-            }
+            int32_t j = m < el->edges_start[i] ? i : neighbour(el, i, m);
             if (c->particle_mark[j]) continue;
-            c->particle_mark[j] = 1, ++seen;
+            c->particle_mark[j] = 1;
             local_motion_of(c, el, col, j);
         }
     }
-    for (int32_t k = 0; k < count && seen; ++k) {
+    for (int32_t k = 0; k < count; ++k) {
         int32_t i = particles[k];
         c->particle_mark[i] = 0;
-        for (int32_t m = el->edges_start[i]; m < el->edges_start[i + 1]; ++m) {
-            const int32_t *e = el->edges + 2 * (size_t)el->edges_of[m];
-            c->particle_mark[e[0]] = 0, c->particle_mark[e[1]] = 0;
-        }
+        for (int32_t m = el->edges_start[i]; m < el->edges_start[i + 1]; ++m)
+            c->particle_mark[neighbour(el, i, m)] = 0;
     }
 }
 

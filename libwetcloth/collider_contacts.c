@@ -606,6 +606,15 @@ static int feature_scratch(wc_collider_contacts *s, int32_t n)
     return 1;
 }
 
+/* How far element e and the collider near it can have come from its
+ * snapshot: the collider's motion near the element counts at its first
+ * particle (candidates.h, local motion). */
+static double element_drift(const wc_candidates *cand, const wc_pair_lists *l, int32_t e,
+                            const int32_t *idx, const wc_particle_arrays *p)
+{
+    return wci_pair_lists_drift(l, e, idx, p) + (wc_candidates_path_now(cand, idx[0]) - l->path_at[e]);
+}
+
 /* Element e against the collider features its list keeps through the
  * filter, in ascending order of the feature (see survivors), gathered again
  * after each push. A visit that pushed nothing renews the element's
@@ -620,9 +629,7 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
     const wc_pair_lists *l = kind->lists;
     const wc_candidates *cand = &s->cand[k];
     double reach = feature_reach(r) + FILTER_EPSILON(r);
-    /* the collider's motion near the element counts at its first particle
-     * (candidates.h, local motion) */
-    double drift = wci_pair_lists_drift(l, e, idx, p) + (wc_candidates_path_now(cand, idx[0]) - l->path_at[e]);
+    double drift = element_drift(cand, l, e, idx, p);
     /* nothing in the list can touch: the cheap way out of most visits */
     if (!s->use_filter ? l->count[e] == 0 : l->least[e] - l->debt[e] - drift > reach) return 0;
     double mu = sqrt(c->material.friction * col->friction), rest = INFINITY;
@@ -658,7 +665,7 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
         if (hit < 0) break;
         pushed = 1, after = hit;
         /* the push moved the element (and perhaps rebased its list) */
-        drift = wci_pair_lists_drift(l, e, idx, p) + (wc_candidates_path_now(cand, idx[0]) - l->path_at[e]);
+        drift = element_drift(cand, l, e, idx, p);
     }
     if (!pushed) {
         /* One gathering, every survivor measured at the ends as they are:
