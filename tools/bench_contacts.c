@@ -345,10 +345,10 @@ int main(int argc, char **argv)
         }
         if (o.trace)
             fprintf(stderr, "frame %d: %.1f ms (collide %.1f), longest link %.3f, fail-safe %lld, "
-                            "halved steps %d, intersections %d\n",
+                            "halved steps %d, intersections %d (with the collider %d)\n",
                     f, 1e3 * frame_seconds, 1e3 * stats.collide_seconds,
                     longest, (long long)stats.failsafe_particles, frame_halved,
-                    o.check == 2 ? last_intersections : -1);
+                    o.check == 2 ? last_intersections : -1, o.check == 2 ? last_collider : -1);
     }
     if (out) fclose(out);
     int frames_done = o.frames;
