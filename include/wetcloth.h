@@ -246,9 +246,12 @@ typedef struct wc_material {
     /// wc_cloth_set_air_velocity gives one). [0, 1e4]. Default 0.02.
     double air_drag;
     /// Collision thickness of the cloth, m, [0, 1]: particles keep at least
-    /// this much (plus the collider's thickness) from every surface, and at
-    /// least this much from other parts of the same cloth when it
-    /// self-collides, and from other cloths it collides with. Default 0.005.
+    /// this much (plus the collider's thickness) from every surface (the
+    /// cloth's triangles and edges keep 0.9 of it from a mesh collider's
+    /// vertices and edges, so that a cloth resting on a smooth dense mesh
+    /// is held by its faces alone), and at least this much from other
+    /// parts of the same cloth when it self-collides, and from other cloths
+    /// it collides with. Default 0.005.
     double thickness;
     /// Coulomb friction coefficient against colliders and itself, [0, 10].
     /// A contact uses sqrt(cloth friction * collider friction). Default 0.5.
@@ -592,8 +595,9 @@ typedef struct wc_mesh_collider_def {
     const int32_t *triangles;
     /// Number of triangles, 1 .. 2^27.
     int32_t triangle_count;
-    /// Thickness, m, [0, 1]: cloth keeps this much (plus its own thickness)
-    /// from the surface. Default 0.
+    /// Thickness, m, [0, 1]: cloth particles keep this much (plus the
+    /// cloth's thickness) from the surface, the cloth's triangles and edges
+    /// 0.9 of it from the mesh's vertices and edges. Default 0.
     double thickness;
     /// Coulomb friction coefficient, [0, 10]. Default 0.5.
     double friction;

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "narrowphase.h"
 #include "primitives.h"
 
 /* Margins, as fractions of the contact distance r: never less than LOW
@@ -272,13 +273,14 @@ static int particle_list(wc_candidates *c, scratch *s, const wc_collider *col, c
     return keep_sorted(c, &c->particles, i, e, kept, c->base_path[i], p);
 }
 
-/* Cloth triangle t's list: collider vertices within r + M of it (its
- * corners at their bases), found through the collider triangles near it. */
+/* Cloth triangle t's list: collider vertices within the feature distance
+ * plus M of it (its corners at their bases), found through the collider
+ * triangles near it. */
 static int triangle_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, const wc_collider *col,
                          const wc_bvh *bvh, int32_t t, double path)
 {
     const int32_t *idx = el->triangles + 3 * (size_t)t;
-    double reach = c->r + element_margin(c, idx, 3), box[6], a[3], b[3], d[3];
+    double reach = c->feature_r + element_margin(c, idx, 3), box[6], a[3], b[3], d[3];
     element_box(c, idx, 3, reach, box);
     int32_t n = query(c, bvh, box);
     if (n < 0) return 0;
@@ -325,12 +327,13 @@ static double segment_lower_bound(const double p[3], const double q[3], const do
     return sqrt(d2) - sqrt(half2);
 }
 
-/* Cloth edge e's list: collider edges within r + M of it. */
+/* Cloth edge e's list: collider edges within the feature distance plus M
+ * of it. */
 static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, const wc_collider *col,
                      const wc_bvh *bvh, int32_t edge, double path)
 {
     const int32_t *idx = el->edges + 2 * (size_t)edge;
-    double reach = c->r + element_margin(c, idx, 2), box[6], a[3], b[3];
+    double reach = c->feature_r + element_margin(c, idx, 2), box[6], a[3], b[3];
     element_box(c, idx, 2, reach, box);
     int32_t n = query(c, bvh, box);
     if (n < 0) return 0;
@@ -412,6 +415,7 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
         !lists_init(&c->triangles, el->triangle_count, 3) || !lists_init(&c->edges, el->edge_count, 2))
         return WC_ERROR_OUT_OF_MEMORY;
     c->r = r;
+    c->feature_r = WC_FEATURE_DISTANCE * r;
     scratch s = {NULL, 0};
     int ok = 1;
     for (int32_t i = 0; i < el->particle_count; ++i) c->local_path[i] = 0.0, c->local_step[i] = 0.0;
@@ -544,7 +548,7 @@ double wci_candidates_ceiling(const wc_candidates *c, const int32_t *idx, int co
         double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if (d2 > far2) far2 = d2;
     }
-    return c->r + element_margin(c, idx, count) - sqrt(far2);
+    return c->feature_r + element_margin(c, idx, count) - sqrt(far2);
 }
 
 /* The larger distance of particle i at the start and at the end of the

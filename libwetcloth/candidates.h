@@ -8,7 +8,9 @@
  * positions (where they were when they were last rebased) and the collider
  * as it was then; each pair keeps its exact distance d0 there, and a pair
  * is listed when d0 <= r + M (r the contact distance, M the largest margin
- * of the owner's particles). A particle's margin comes from its motion when
+ * of the owner's particles; for the triangles' and edges' lists r is the
+ * feature distance, WC_FEATURE_DISTANCE times the particles' in
+ * narrowphase.h, and so it is in what follows). A particle's margin comes from its motion when
  * it is rebased, so a resting cloth keeps its lists for as long as it rests
  * and a falling one rebases about once per margin travelled.
  *
@@ -114,8 +116,10 @@ typedef struct wc_pair_lists {
 
 /// One cloth against one mesh collider.
 typedef struct wc_candidates {
-    /// Contact distance the lists were made for; 0 until made.
-    double r;
+    /// Contact distances the lists were made for: a particle's against
+    /// faces, and a cloth triangle's or edge's against collider features
+    /// (WC_FEATURE_DISTANCE r); 0 until made.
+    double r, feature_r;
     /// Per particle: base position (xyz), margin, and its local path at its
     /// last rebase.
     double *base, *margin, *base_path;

@@ -751,7 +751,7 @@ static int feature_pass(wc_collider_contacts *s, wc_cloth *c, const wc_particle_
         for (int32_t k = 0; k < count; ++k) {
             const wc_collider *col = colliders[k];
             if (!col->is_mesh) continue;
-            double r = contact_distance(c, col);
+            double r = WC_FEATURE_DISTANCE * contact_distance(c, col);
             const wc_candidates *cand = &s->cand[k];
             element_kind triangles = {3, s->el.triangles, &cand->triangles, s->el.triangles_start,
                                       s->el.triangles_of};

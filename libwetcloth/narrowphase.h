@@ -31,6 +31,22 @@
 /// intersection needs a violation of the whole contact distance).
 #define WC_FEATURE_SLACK 1e-2
 
+/// The contact distance of a collider feature (a vertex against a cloth
+/// triangle, an edge against a cloth edge), as a fraction of the particle
+/// contact distance r. Features hold the cloth a little nearer than faces
+/// do, so that a cloth resting at r on the faces of a smooth dense collider
+/// is not also resting on its vertices and edges: the chord of a cloth
+/// edge of length L over a collider of radius R dips L^2 / (8 R) below its
+/// ends (0.15 mm for a 2 cm edge over a 0.3 m sphere), which at a feature
+/// distance of r put every collider edge a cloth edge lies over inside
+/// reach, and each got its exact test at every step (the 50 x 50 cloth on
+/// the 30,624-triangle sphere: 38 M edge-edge tests in 12 frames for 1,003
+/// pushes). At 0.9 r those pairs sit 0.1 r clear and the candidates' filter
+/// skips them; only features that really stand proud of the faces (a
+/// faceted solid's corners, a thin plate's rim) are tested. The guarantee
+/// does not depend on it: any positive distance keeps the cloth out.
+#define WC_FEATURE_DISTANCE 0.9
+
 /// Particle moving from start to end against collider triangle t of a mesh
 /// collider at contact distance r. Returns 1 and fills the record (source,
 /// count 1 with the particle index `particle`, normal, distance, target r,

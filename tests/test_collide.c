@@ -10,6 +10,7 @@
 
 #include "cloth.h"
 #include "collider_contacts.h"
+#include "narrowphase.h"
 #include "primitives.h"
 #include "scenes.h"
 #include "test_util.h"
@@ -163,13 +164,14 @@ static int32_t one_step_against(const double *collider, int32_t vertex_count, co
  * half-way and comes back reversed. Judging the start's side along it at
  * the start while pushing along it at the end tilted AB into the collider's
  * edge (and, in the 101 x 101 drape at 8 implicit steps per frame, pushed
- * cloth into the sphere). The push must leave both ends at the contact
- * distance above the collider's edge (to the passes' 1 % slack). */
+ * cloth into the sphere). The push must leave both ends at the feature
+ * contact distance (WC_FEATURE_DISTANCE r) above the collider's edge (to
+ * the passes' 1 % slack). */
 static void edge_turning_over_an_edge(void)
 {
     double collider[9] = {-0.05, 0, 0, 0.05, 0, 0, 0, 0, -0.05};
     int32_t tri[3] = {0, 1, 2};
-    double r = CLOTH_THICKNESS, z0 = 0.8 * r, half = 0.1, dt = 1e-3;
+    double r = WC_FEATURE_DISTANCE * CLOTH_THICKNESS, z0 = 0.8 * r, half = 0.1, dt = 1e-3;
     double angle = 10.0 * 3.14159265358979323846 / 180.0;
     double c = cos(angle) * half, s = sin(angle) * half;
     /* A and B turn; C, far above, stays */
@@ -180,8 +182,8 @@ static void edge_turning_over_an_edge(void)
            end[2], end[5], r, (int)crossing);
     for (int i = 0; i < 2; ++i)
         CHECK(end[3 * i + 2] > 0.98 * r && end[3 * i + 2] < 1.02 * r,
-              "cloth particle %d ends at z = %.6g, expected the contact distance %.4g above the "
-              "collider's edge", i, end[3 * i + 2], r);
+              "cloth particle %d ends at z = %.6g, expected the feature contact distance %.4g above "
+              "the collider's edge", i, end[3 * i + 2], r);
     CHECK(crossing == 0, "%d cloth-collider intersections", (int)crossing);
 }
 
@@ -190,13 +192,13 @@ static void edge_turning_over_an_edge(void)
  * lies 0.8 r above it, and its third particle moves across the edge of the
  * other two, so the triangle's normal turns over while the tip ends under
  * it. Judged along the start's normal, the push took the cloth 4 cm down
- * past the tip. It must keep the cloth above the tip, at the contact
- * distance, and the third particle free to cross. */
+ * past the tip. It must keep the cloth above the tip, at the feature
+ * contact distance, and the third particle free to cross. */
 static void triangle_turning_over_a_vertex(void)
 {
     double collider[15] = {0, 0, 0, -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1};
     int32_t tris[12] = {0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1};
-    double r = CLOTH_THICKNESS, z0 = 0.8 * r, dt = 1e-3;
+    double r = WC_FEATURE_DISTANCE * CLOTH_THICKNESS, z0 = 0.8 * r, dt = 1e-3;
     double p[9] = {-0.05, 0.02, z0, 0.05, 0.02, z0, 0, 0.06, z0};
     double v[9] = {0, 0, 0, 0, 0, 0, 0, -0.12 / dt, 0}, end[9];
     int32_t crossing = one_step_against(collider, 5, tris, 4, p, v, dt, end);
@@ -214,8 +216,8 @@ static void triangle_turning_over_a_vertex(void)
           "the collider's vertex ends outside the cloth triangle (barycentric %.3g %.3g %.3g): the "
           "third particle did not cross", w[0], w[1], w[2]);
     CHECK(z > 0.98 * r && z < 1.02 * r,
-          "the cloth triangle ends z = %.6g above the collider's vertex, expected the contact "
-          "distance %.4g", z, r);
+          "the cloth triangle ends z = %.6g above the collider's vertex, expected the feature "
+          "contact distance %.4g", z, r);
     CHECK(crossing == 0, "%d cloth-collider intersections", (int)crossing);
 }
 
