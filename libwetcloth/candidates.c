@@ -40,7 +40,7 @@ void wci_candidates_destroy(wc_candidates *c)
     wci_free(c->base), wci_free(c->margin), wci_free(c->base_path);
     wci_free(c->local_path), wci_free(c->local_step), wci_free(c->particle_mark);
     lists_free(&c->particles), lists_free(&c->triangles), lists_free(&c->edges);
-    wci_free(c->vertex_seen), wci_free(c->edge_seen), wci_free(c->found), wci_free(c->gathered), wci_free(c->gathered_d0);
+    wci_free(c->found), wci_free(c->gathered), wci_free(c->gathered_d0);
     memset(c, 0, sizeof *c);
 }
 
@@ -256,12 +256,12 @@ static void element_box(const wc_candidates *c, const int32_t *idx, int count, d
 }
 
 /* Particle i's list: collider triangles within r + margin of its base. */
-static int particle_list(wc_candidates *c, scratch *s, const wc_collider *col, const wc_bvh *bvh, int32_t i)
+static int particle_list(wc_candidates *c, scratch *s, const wc_collider *col, int32_t i)
 {
     double p[3], reach = c->r + c->margin[i], box[6];
     base_of(c, i, p);
     for (int k = 0; k < 3; ++k) box[k] = p[k] - reach, box[k + 3] = p[k] + reach;
-    int32_t n = query(c, bvh, box);
+    int32_t n = query(c, &col->bvh, box);
     if (n < 0) return 0;
     pair_entry *e = entries(c, n, &s->e, &s->cap);
     if (!e) return 0;
@@ -274,32 +274,27 @@ static int particle_list(wc_candidates *c, scratch *s, const wc_collider *col, c
 }
 
 /* Cloth triangle t's list: collider vertices within the feature distance
- * plus M of it (its corners at their bases), found through the collider
- * triangles near it. */
+ * plus M of it (its corners at their bases), from the collider's vertex
+ * tree. */
 static int triangle_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, const wc_collider *col,
-                         const wc_bvh *bvh, int32_t t, double path)
+                         int32_t t, double path)
 {
     const int32_t *idx = el->triangles + 3 * (size_t)t;
     double reach = c->feature_r + element_margin(c, idx, 3), box[6], a[3], b[3], d[3];
     element_box(c, idx, 3, reach, box);
-    int32_t n = query(c, bvh, box);
+    int32_t n = query(c, &col->vertex_bvh, box);
     if (n < 0) return 0;
-    pair_entry *e = entries(c, 3 * (int64_t)n, &s->e, &s->cap);
+    pair_entry *e = entries(c, n, &s->e, &s->cap);
     if (!e) return 0;
     base_of(c, idx[0], a), base_of(c, idx[1], b), base_of(c, idx[2], d);
-    int32_t kept = 0, seen = 0;
-    for (int32_t k = 0; k < n; ++k)
-        for (int j = 0; j < 3; ++j) {
-            int32_t v = col->triangles[3 * (size_t)c->found[k] + j];
-            if (c->vertex_seen[v]) continue;
-            c->vertex_seen[v] = 1;
-            c->gathered[seen++] = v;
-            double p[3], w[3];
-            vertex_of(col->current, v, p);
-            double dist = sqrt(wci_point_triangle_closest(p, a, b, d, w));
-            if (dist <= reach) e[kept].d0 = dist, e[kept].item = v, ++kept;
-        }
-    for (int32_t k = 0; k < seen; ++k) c->vertex_seen[c->gathered[k]] = 0;
+    int32_t kept = 0;
+    for (int32_t k = 0; k < n; ++k) {
+        int32_t v = col->used_vertices[c->found[k]];
+        double p[3], w[3];
+        vertex_of(col->current, v, p);
+        double dist = sqrt(wci_point_triangle_closest(p, a, b, d, w));
+        if (dist <= reach) e[kept].d0 = dist, e[kept].item = v, ++kept;
+    }
     double snap[9];
     memcpy(snap, a, sizeof a), memcpy(snap + 3, b, sizeof b), memcpy(snap + 6, d, sizeof d);
     return keep_sorted(c, &c->triangles, t, e, kept, path, snap);
@@ -328,36 +323,30 @@ static double segment_lower_bound(const double p[3], const double q[3], const do
 }
 
 /* Cloth edge e's list: collider edges within the feature distance plus M
- * of it. */
+ * of it, from the collider's edge tree. */
 static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, const wc_collider *col,
-                     const wc_bvh *bvh, int32_t edge, double path)
+                     int32_t edge, double path)
 {
     const int32_t *idx = el->edges + 2 * (size_t)edge;
     double reach = c->feature_r + element_margin(c, idx, 2), box[6], a[3], b[3];
     element_box(c, idx, 2, reach, box);
-    int32_t n = query(c, bvh, box);
+    int32_t n = query(c, &col->edge_bvh, box);
     if (n < 0) return 0;
-    pair_entry *e = entries(c, 3 * (int64_t)n, &s->e, &s->cap);
+    pair_entry *e = entries(c, n, &s->e, &s->cap);
     if (!e) return 0;
     base_of(c, idx[0], a), base_of(c, idx[1], b);
-    int32_t kept = 0, seen = 0;
-    for (int32_t k = 0; k < n; ++k)
-        for (int j = 0; j < 3; ++j) {
-            int32_t f = col->triangle_edges[3 * (size_t)c->found[k] + j];
-            if (f < 0 || c->edge_seen[f]) continue;
-            c->edge_seen[f] = 1;
-            c->gathered[seen++] = f;
-            double p[3], q[3], u, v;
-            vertex_of(col->current, col->edges[2 * (size_t)f], p);
-            vertex_of(col->current, col->edges[2 * (size_t)f + 1], q);
-            /* cheap bound first: no point of the collider edge is nearer to
-             * the cloth edge than its midpoint's distance less half its
-             * length */
-            if (segment_lower_bound(p, q, a, b) > reach) continue;
-            double dist = sqrt(wci_segment_segment_closest(p, q, a, b, &u, &v));
-            if (dist <= reach) e[kept].d0 = dist, e[kept].item = f, ++kept;
-        }
-    for (int32_t k = 0; k < seen; ++k) c->edge_seen[c->gathered[k]] = 0;
+    int32_t kept = 0;
+    for (int32_t k = 0; k < n; ++k) {
+        int32_t f = c->found[k];
+        double p[3], q[3], u, v;
+        vertex_of(col->current, col->edges[2 * (size_t)f], p);
+        vertex_of(col->current, col->edges[2 * (size_t)f + 1], q);
+        /* cheap bound first: no point of the collider edge is nearer to the
+         * cloth edge than its midpoint's distance less half its length */
+        if (segment_lower_bound(p, q, a, b) > reach) continue;
+        double dist = sqrt(wci_segment_segment_closest(p, q, a, b, &u, &v));
+        if (dist <= reach) e[kept].d0 = dist, e[kept].item = f, ++kept;
+    }
     double snap[6];
     memcpy(snap, a, sizeof a), memcpy(snap + 3, b, sizeof b);
     return keep_sorted(c, &c->edges, edge, e, kept, path, snap);
@@ -391,7 +380,7 @@ static void rebase_one(wc_candidates *c, const wc_collider *col, int32_t i,
     c->base_path[i] = c->local_path[i];
 }
 
-static int allocate(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col)
+static int allocate(wc_candidates *c, const wc_cloth_elements *el)
 {
     size_t n = el->particle_count > 0 ? (size_t)el->particle_count : 1;
     /* each made once; a failed call leaves the others for the retry */
@@ -401,17 +390,13 @@ static int allocate(wc_candidates *c, const wc_cloth_elements *el, const wc_coll
     if (!c->local_path) c->local_path = wci_alloc_array(n, sizeof *c->local_path);
     if (!c->local_step) c->local_step = wci_alloc_array(n, sizeof *c->local_step);
     if (!c->particle_mark) c->particle_mark = wci_alloc_array(n, 1);
-    if (!c->base_path || !c->local_path || !c->local_step || !c->particle_mark) return 0;
-    if (!c->vertex_seen) c->vertex_seen = wci_alloc_array((size_t)col->vertex_count, 1);
-    if (!c->edge_seen) c->edge_seen = wci_alloc_array((size_t)col->edge_count + 1, 1);
-    return c->base && c->margin && c->base_path && c->vertex_seen && c->edge_seen;
+    return c->base && c->margin && c->base_path && c->local_path && c->local_step && c->particle_mark;
 }
 
 wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
                               double r, const wc_particle_arrays *p, int32_t steps_left)
 {
-    const wc_bvh *bvh = &col->bvh;
-    if (!allocate(c, el, col) || !lists_init(&c->particles, el->particle_count, 1) ||
+    if (!allocate(c, el) || !lists_init(&c->particles, el->particle_count, 1) ||
         !lists_init(&c->triangles, el->triangle_count, 3) || !lists_init(&c->edges, el->edge_count, 2))
         return WC_ERROR_OUT_OF_MEMORY;
     c->r = r;
@@ -420,11 +405,11 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
     int ok = 1;
     for (int32_t i = 0; i < el->particle_count; ++i) c->local_path[i] = 0.0, c->local_step[i] = 0.0;
     for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, i, p, steps_left);
-    for (int32_t i = 0; i < el->particle_count && ok; ++i) ok = particle_list(c, &s, col, bvh, i);
+    for (int32_t i = 0; i < el->particle_count && ok; ++i) ok = particle_list(c, &s, col, i);
     for (int32_t t = 0; t < el->triangle_count && ok; ++t)
-        ok = triangle_list(c, &s, el, col, bvh, t, c->local_path[el->triangles[3 * (size_t)t]]);
+        ok = triangle_list(c, &s, el, col, t, c->local_path[el->triangles[3 * (size_t)t]]);
     for (int32_t e = 0; e < el->edge_count && ok; ++e)
-        ok = edge_list(c, &s, el, col, bvh, e, c->local_path[el->edges[2 * (size_t)e]]);
+        ok = edge_list(c, &s, el, col, e, c->local_path[el->edges[2 * (size_t)e]]);
     wci_free(s.e);
     if (!ok) {
         c->r = 0.0; /* made again at the next use */
@@ -438,11 +423,10 @@ wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, c
                                const int32_t *particles, int32_t count, const wc_particle_arrays *p,
                                int32_t steps_left, uint8_t *mark)
 {
-    const wc_bvh *bvh = &col->bvh;
     scratch s = {NULL, 0};
     int ok = 1;
     for (int32_t k = 0; k < count; ++k) rebase_one(c, col, particles[k], p, steps_left);
-    for (int32_t k = 0; k < count && ok; ++k) ok = particle_list(c, &s, col, bvh, particles[k]);
+    for (int32_t k = 0; k < count && ok; ++k) ok = particle_list(c, &s, col, particles[k]);
     /* each triangle and edge of a rebased particle once, in the order met */
     for (int kind = 0; kind < 2 && ok; ++kind) {
         const int32_t *start = kind ? el->edges_start : el->triangles_start;
@@ -453,8 +437,8 @@ wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, c
                 if (mark[e]) continue;
                 mark[e] = 1;
                 int32_t first = kind ? el->edges[2 * (size_t)e] : el->triangles[3 * (size_t)e];
-                ok = kind ? edge_list(c, &s, el, col, bvh, e, c->local_path[first])
-                          : triangle_list(c, &s, el, col, bvh, e, c->local_path[first]);
+                ok = kind ? edge_list(c, &s, el, col, e, c->local_path[first])
+                          : triangle_list(c, &s, el, col, e, c->local_path[first]);
             }
         for (int32_t k = 0; k < count; ++k)
             for (int32_t j = start[particles[k]]; j < start[particles[k] + 1]; ++j) mark[items[j]] = 0;

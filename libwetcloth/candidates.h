@@ -134,8 +134,8 @@ typedef struct wc_candidates {
     /// largest (its step motion), as if the whole collider were near.
     int whole_collider;
     wc_pair_lists particles, triangles, edges;
-    /// Scratch: collider vertices and edges already gathered for one owner.
-    uint8_t *vertex_seen, *edge_seen;
+    /// Scratch: the collider items a query found, and one owner's kept ids
+    /// and distances.
     int32_t *found;
     int32_t found_capacity;
     int32_t *gathered;

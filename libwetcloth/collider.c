@@ -46,11 +46,16 @@ void wci_collider_destroy(wc_collider *c)
     wci_free(c->target);
     wci_free(c->next);
     wci_free(c->boxes);
+    wci_free(c->edge_boxes);
+    wci_free(c->vertex_boxes);
+    wci_free(c->used_vertices);
     wci_free(c->normals);
     wci_free(c->vertex_motion);
     wci_free(c->triangle_motion);
     wci_free(c->node_motion);
     wci_bvh_destroy(&c->bvh);
+    wci_bvh_destroy(&c->edge_bvh);
+    wci_bvh_destroy(&c->vertex_bvh);
     wci_convex_shape_destroy(&c->convex);
     wci_free(c);
 }
@@ -61,6 +66,18 @@ static int compare_triples(const void *pa, const void *pb)
     for (int k = 0; k < 3; ++k)
         if (p[k] != q[k]) return p[k] < q[k] ? -1 : 1;
     return 0;
+}
+
+/* The vertices the triangles use, ascending (marked in used_vertices'
+ * own room first: it has one entry per vertex). */
+static void used_vertices(wc_collider *c)
+{
+    int32_t *mark = c->used_vertices, n = 0;
+    memset(mark, 0, (size_t)c->vertex_count * sizeof *mark);
+    for (size_t j = 0; j < 3 * (size_t)c->triangle_count; ++j) mark[c->triangles[j]] = 1;
+    for (int32_t v = 0; v < c->vertex_count; ++v)
+        if (mark[v]) mark[n++] = v;
+    c->used_vertex_count = n;
 }
 
 /* The unique edges of a mesh collider's triangles, sorted, and each
@@ -176,19 +193,27 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
         c->vertex_count = d->vertex_count;
         c->triangle_count = d->triangle_count;
         memset(&c->bvh, 0, sizeof c->bvh);
+        memset(&c->edge_bvh, 0, sizeof c->edge_bvh);
+        memset(&c->vertex_bvh, 0, sizeof c->vertex_bvh);
         c->triangles = wci_alloc_array(3 * nt, sizeof *c->triangles);
         c->current = wci_alloc_array(nv, sizeof *c->current);
         c->target = wci_alloc_array(nv, sizeof *c->target);
         c->next = wci_alloc_array(nv, sizeof *c->next);
         c->boxes = wci_alloc_array(6 * nt, sizeof *c->boxes);
+        c->vertex_boxes = wci_alloc_array(2 * nv, sizeof *c->vertex_boxes);
+        c->used_vertices = wci_alloc_array(nv / 3, sizeof *c->used_vertices);
         c->normals = wci_alloc_array(3 * nt, sizeof *c->normals);
     }
-    if (!c || !c->triangles || !c->current || !c->target || !c->next || !c->boxes || !c->normals) {
+    if (!c || !c->triangles || !c->current || !c->target || !c->next || !c->boxes ||
+        !c->vertex_boxes || !c->used_vertices || !c->normals) {
         wci_collider_destroy(c);
         return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
     }
     memcpy(c->triangles, d->triangles, 3 * nt * sizeof *c->triangles);
-    if (!build_edges(c)) {
+    used_vertices(c);
+    if (!build_edges(c) ||
+        !(c->edge_boxes = wci_alloc_array(6 * (size_t)(c->edge_count ? c->edge_count : 1),
+                                           sizeof *c->edge_boxes))) {
         wci_collider_destroy(c);
         return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
     }
@@ -207,6 +232,8 @@ wc_status wc_world_add_convex_collider(wc_world *w, const wc_convex_collider_def
     wc_collider *c = wci_alloc_array(1, sizeof *c);
     if (!c) return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a collider");
     memset(&c->bvh, 0, sizeof c->bvh);
+    memset(&c->edge_bvh, 0, sizeof c->edge_bvh);
+    memset(&c->vertex_bvh, 0, sizeof c->vertex_bvh);
     wc_status s = wci_convex_shape_create(&c->convex, &c->pose_current, d, &w->error);
     if (s) {
         wci_collider_destroy(c);
@@ -298,20 +325,41 @@ static void grow_box(double box[6], const double *p)
     }
 }
 
-/* Every triangle's box over the running advance (its corners now and at the
- * target), and the tree over them: built the first time, refit after, so a
- * deforming collider pays one pass over its triangles per advance. */
-static wc_status index_mesh(wc_collider *c)
+/* Boxes over the running advance of `count` items of `per` vertices each
+ * (their corners now and at the target). */
+static void advance_boxes(const wc_collider *c, const int32_t *items, int per, int32_t count,
+                          double *boxes)
 {
-    for (int32_t t = 0; t < c->triangle_count; ++t) {
-        double *box = c->boxes + 6 * (size_t)t;
+    for (int32_t t = 0; t < count; ++t) {
+        double *box = boxes + 6 * (size_t)t;
         for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
-        for (int k = 0; k < 3; ++k) {
-            size_t v = 3 * (size_t)c->triangles[3 * (size_t)t + k];
+        for (int k = 0; k < per; ++k) {
+            size_t v = 3 * (size_t)items[(size_t)per * (size_t)t + k];
             grow_box(box, c->current + v);
             grow_box(box, c->target + v);
         }
     }
+}
+
+/* A tree over `count` boxes: built the first time, refit after. */
+static wc_status index_boxes(wc_bvh *bvh, const double *boxes, int32_t count)
+{
+    if (bvh->node_count == 0) return wci_bvh_create(bvh, boxes, count);
+    wci_bvh_refit(bvh);
+    return WC_OK;
+}
+
+/* Every triangle's, edge's and vertex's box over the running advance, and
+ * the trees over them: built the first time, refit after, so a deforming
+ * collider pays one pass over its triangles per advance. */
+static wc_status index_mesh(wc_collider *c)
+{
+    advance_boxes(c, c->triangles, 3, c->triangle_count, c->boxes);
+    advance_boxes(c, c->edges, 2, c->edge_count, c->edge_boxes);
+    advance_boxes(c, c->used_vertices, 1, c->used_vertex_count, c->vertex_boxes);
+    if (index_boxes(&c->edge_bvh, c->edge_boxes, c->edge_count) ||
+        index_boxes(&c->vertex_bvh, c->vertex_boxes, c->used_vertex_count))
+        return WC_ERROR_OUT_OF_MEMORY;
     if (c->bvh.node_count == 0) {
         if (wci_bvh_create(&c->bvh, c->boxes, c->triangle_count)) return WC_ERROR_OUT_OF_MEMORY;
         double total = 0.0;

@@ -61,6 +61,16 @@ typedef struct wc_collider {
     /// step, refit (not rebuilt) when the collider is given new vertices.
     double *boxes;
     wc_bvh bvh;
+    /// The same for the unique edges, and for the vertices that triangles
+    /// use (`used_vertices`, ascending; the tree's items index it): the
+    /// cloth's edges and triangles find the collider's edges and vertices
+    /// near them directly, each once, in boxes as thin as the feature
+    /// (through the triangles, each edge came twice and each vertex about
+    /// six times, in boxes as large as a triangle).
+    double *edge_boxes, *vertex_boxes;
+    wc_bvh edge_bvh, vertex_bvh;
+    int32_t *used_vertices;
+    int32_t used_vertex_count;
     /// Whether the boxes and the tree describe the running advance.
     int indexed;
     /// Mean length of the triangles' edges when the tree was built: the
