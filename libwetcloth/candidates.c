@@ -521,7 +521,7 @@ void wci_candidates_commit(wc_candidates *c, int32_t particle_count)
     for (int32_t i = 0; i < particle_count; ++i) c->local_path[i] += c->local_step[i], c->local_step[i] = 0.0;
 }
 
-double wci_candidates_ceiling(const wc_candidates *c, const int32_t *idx, int count,
+double wci_candidates_ceiling(const wc_candidates *c, double r, const int32_t *idx, int count,
                               const wc_particle_arrays *p)
 {
     double far2 = 0.0;
@@ -532,7 +532,7 @@ double wci_candidates_ceiling(const wc_candidates *c, const int32_t *idx, int co
         double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if (d2 > far2) far2 = d2;
     }
-    return c->feature_r + element_margin(c, idx, count) - sqrt(far2);
+    return r + element_margin(c, idx, count) - sqrt(far2);
 }
 
 /* The larger distance of particle i at the start and at the end of the

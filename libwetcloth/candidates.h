@@ -81,16 +81,19 @@
 /// the end of the pool.
 ///
 /// Snapshots. A list is made with every pair's exact distance at its
-/// particles' bases (and the collider as it was then). The feature pass
-/// measures the distance of the pairs it tests anyway, so after a visit that
-/// pushed nothing it renews the owner's snapshot to the particles' present
-/// ends: tested pairs get the distance just measured, the others their old
-/// bound less how far the owner has moved since. That subtraction is the
-/// owner's debt, one number: a renewal adds to it and writes only the pairs
-/// it measured (their distance plus the debt), so its cost follows the few
-/// pairs near contact, not the list (every item rewritten was 5 % of a
-/// dense collider's step). Only the feature lists are renewed: a particle
-/// list's debt stays 0. How far an owner has moved since its snapshot is
+/// particles' bases (and the collider as it was then). The passes measure
+/// the distance of the pairs they test anyway, so after a visit they renew
+/// the owner's snapshot to the particles' present ends: tested pairs get
+/// the distance just measured, the others their old bound less how far the
+/// owner has moved since. That subtraction is the owner's debt, one number:
+/// a renewal adds to it and writes only the pairs it measured (their
+/// distance plus the debt), so its cost follows the few pairs near contact,
+/// not the list (every item rewritten was 5 % of a dense collider's step).
+/// A feature list is renewed after a visit that pushed nothing; a
+/// particle's after every visit that tested its whole list, a measurement
+/// taken before a push counting its distance less how far the pushes after
+/// it moved the particle (a resting particle is pushed back at nearly every
+/// step). How far an owner has moved since its snapshot is
 /// the largest distance of its particles, at the start and at the end of
 /// the step, from where they were at the snapshot (kept per particle of
 /// the owner, `per` of them, xyz): the argument above
@@ -191,11 +194,12 @@ void wci_candidates_local_motion(wc_candidates *cand, const wc_cloth_elements *e
 /// After a committed step: every particle's local step added to its path.
 void wci_candidates_commit(wc_candidates *cand, int32_t particle_count);
 
-/// The most a renewed snapshot of the element with particles idx[0 ..
-/// count) may credit a pair with: r + M - D, M the largest margin of its
-/// particles, D the farthest of their ends from their bases (see the local
-/// motion above).
-double wci_candidates_ceiling(const wc_candidates *cand, const int32_t *idx, int count,
+/// The most a renewed snapshot of the owner with particles idx[0 .. count)
+/// may credit a pair with: r + M - D, r the distance its list was made for
+/// (cand->r for a particle's, cand->feature_r for a triangle's or an
+/// edge's), M the largest margin of its particles, D the farthest of their
+/// ends from their bases (see the local motion above).
+double wci_candidates_ceiling(const wc_candidates *cand, double r, const int32_t *idx, int count,
                               const wc_particle_arrays *p);
 
 /// Particle i's distance from its base: the larger at the start (x) and at

@@ -310,13 +310,15 @@ static int answer_particle(particle_run *run, wc_contact *k, const wc_collider *
     return 1;
 }
 
-/* Triangle t against the particle's motion as it is now. */
-static int test_triangle(particle_run *run, const wc_collider *col, int32_t t, double r)
+/* Triangle t against the particle's motion as it is now; *end_d2 gets a
+ * lower bound on the square of their distance at the end of the step
+ * (wci_narrow_particle_triangle). */
+static int test_triangle(particle_run *run, const wc_collider *col, int32_t t, double r, double *end_d2)
 {
     double end[3];
     wc_contact k;
     end_now(run, end);
-    if (!wci_narrow_particle_triangle(col, t, run->i, run->start, end, r, &k)) return 0;
+    if (!wci_narrow_particle_triangle(col, t, run->i, run->start, end, r, end_d2, &k)) return 0;
     return answer_particle(run, &k, col);
 }
 
@@ -403,22 +405,70 @@ static int direct_triangles(particle_run *run, const wc_collider *col, double r,
             found = wci_alloc_array((size_t)n, sizeof *found);
             if (!found) {
                 /* no room for the list: every triangle in turn */
-                for (int32_t t = after + 1; t < col->triangle_count; ++t) moved |= test_triangle(run, col, t, r);
+                double unused;
+                for (int32_t t = after + 1; t < col->triangle_count; ++t)
+                    moved |= test_triangle(run, col, t, r, &unused);
                 return moved;
             }
             wci_bvh_query(&col->bvh, box, found, n);
         }
         int32_t pushed = -1;
+        double unused;
         for (int32_t j = 0; j < n && pushed < 0; ++j)
-            if (found[j] > after && test_triangle(run, col, found[j], r)) pushed = found[j];
+            if (found[j] > after && test_triangle(run, col, found[j], r, &unused)) pushed = found[j];
         if (found != stack) wci_free(found);
         if (pushed < 0) return moved;
         moved = 1, after = pushed;
     }
 }
 
+/* What one visit of a particle's list measured, for the snapshot it
+ * leaves: list positions, the squared distances found there (lower bounds,
+ * at the particle's end when measured), and how far its end had been moved
+ * by pushes before each measurement. */
+typedef struct particle_measures {
+    int32_t at[DIRECT_STACK];
+    double d2[DIRECT_STACK], moved_before[DIRECT_STACK];
+    int32_t n;
+    /// How far pushes have moved the particle's end in this visit, summed.
+    double moved;
+    /// The least bound of the items not gathered, over the gatherings.
+    double rest;
+    /// Whether every test was recorded (there was room).
+    int complete;
+} particle_measures;
+
+/* After a visit of particle i's list: its snapshot renewed at the particle's
+ * end (candidates.h, snapshots). A measurement taken before a push keeps as
+ * bound its distance less how far the pushes after it moved the end (the
+ * distance is 1-Lipschitz in the particle's place), so a visit that pushed
+ * renews too: a particle resting on a collider is pushed back at nearly
+ * every step, and its list measured from its base would keep every
+ * triangle within r plus its drift from the base a survivor (dozens on a
+ * dense collider). The same bits: the filter only leaves out what cannot
+ * touch. */
+static void renew_particle(const wc_candidates *cand, const wc_particle_arrays *p, int32_t i,
+                           particle_measures *m)
+{
+    wc_pair_lists *l = (wc_pair_lists *)&cand->particles;
+    for (int32_t j = 0; j < m->n; ++j) {
+        double owed = m->moved - m->moved_before[j];
+        if (owed > 0.0) {
+            double b = sqrt(m->d2[j]) - owed;
+            m->d2[j] = b > 0.0 ? b * b : 0.0;
+        }
+    }
+    double now = wc_candidates_path_now(cand, i), step = cand->local_step[i];
+    double end_drift = wci_pair_lists_end_drift(l, i, &i, p) + (now - l->path_at[i]);
+    /* the collider counted from before this step, which may yet be refused
+     * and taken again (as in visit_element) */
+    wci_pair_lists_renew(l, i, &i, p, now - 2.0 * step, m->at, m->d2, m->n, m->rest, end_drift,
+                        wci_candidates_ceiling(cand, cand->r, &i, 1, p));
+}
+
 /* One mesh collider against the particle: the items of its list that the
- * filter keeps (candidates.h), in turn. */
+ * filter keeps (candidates.h), in turn, with the bound measured from the
+ * list's snapshot; the visit then renews the snapshot. */
 static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_collider *col,
                          double r, int use_filter)
 {
@@ -426,11 +476,14 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
     const wc_pair_lists *l = &cand->particles;
     int32_t i = run->i, after = -1, stack[DIRECT_STACK], *kept = stack, room = DIRECT_STACK;
     double drift = wc_candidates_path_now(cand, i) - l->path_at[i];
+    particle_measures m;
+    m.n = 0, m.moved = 0.0, m.rest = INFINITY, m.complete = use_filter;
     int moved = 0;
     for (;;) {
         double d = wci_candidates_displacement(cand, p, i);
         if (!wc_candidates_covers(cand, i, d)) {
             run->leaves_cover = 1;
+            m.complete = 0;
             moved |= direct_triangles(run, col, r, after);
             break;
         }
@@ -442,23 +495,49 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
              * 30,624-triangle sphere's pole: 530-870 triangles a query). */
             int32_t *grown = wci_alloc_array((size_t)l->count[i], sizeof *grown);
             if (!grown) {
+                m.complete = 0;
                 moved |= direct_triangles(run, col, r, after);
                 break;
             }
             if (kept != stack) wci_free(kept);
             kept = grown, room = l->count[i];
         }
-        double reach = r + d + drift + FILTER_EPSILON(r), rest;
+        double near = wci_pair_lists_drift(l, i, &i, p);
+        double reach = r + near + drift + l->debt[i] + FILTER_EPSILON(r), rest;
+        /* nothing in the list can touch (the hanging part of a draped
+         * cloth): no scan, and the old snapshot kept, whose bound is the
+         * displacement from it rather than the path since */
+        if (use_filter && after < 0 && l->least[i] > reach) {
+            m.complete = 0;
+            break;
+        }
         int32_t n = survivors(l, i, reach, !use_filter, after, kept, &rest);
+        if (rest < m.rest) m.rest = rest;
         if (n == 0) break;
         const int32_t *item = l->item + l->start[i];
         int32_t pushed = -1;
-        for (int32_t j = 0; j < n && pushed < 0; ++j)
-            if (test_triangle(run, col, item[kept[j]], r)) pushed = item[kept[j]];
+        double before[3] = {p->nx[i], p->ny[i], p->nz[i]};
+        for (int32_t j = 0; j < n && pushed < 0; ++j) {
+            double d2;
+            if (test_triangle(run, col, item[kept[j]], r, &d2)) {
+                /* not measured: it keeps its bound, and counts among the
+                 * least of what the renewal does not measure */
+                pushed = item[kept[j]];
+                if (l->d[l->start[i] + kept[j]] < m.rest) m.rest = l->d[l->start[i] + kept[j]];
+            } else if (m.n < DIRECT_STACK) {
+                m.at[m.n] = kept[j], m.d2[m.n] = d2, m.moved_before[m.n] = m.moved;
+                ++m.n;
+            } else {
+                m.complete = 0;
+            }
+        }
         if (pushed < 0) break;
         moved = 1, after = pushed;
+        double shift[3] = {p->nx[i] - before[0], p->ny[i] - before[1], p->nz[i] - before[2]};
+        m.moved += sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]);
     }
     if (kept != stack) wci_free(kept);
+    if (m.complete) renew_particle(cand, p, i, &m);
     return moved;
 }
 
@@ -679,7 +758,7 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
          * drift covers the collider from there as well as from where it
          * really goes. */
         wci_pair_lists_renew((wc_pair_lists *)l, e, idx, p, now - 2.0 * step, s->kept, s->measured, n, rest,
-                            end_drift, wci_candidates_ceiling(cand, idx, kind->count, p));
+                            end_drift, wci_candidates_ceiling(cand, cand->feature_r, idx, kind->count, p));
     }
     return pushed;
 }

@@ -110,9 +110,10 @@ static void surface_contact(int32_t particle, const double end[3], const double 
 
 int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particle,
                                 const double start[3], const double end[3], double r,
-                                wc_contact *out)
+                                double *end_d2, wc_contact *out)
 {
     double t0[3][3], t1[3][3], n0[3], n1[3];
+    *end_d2 = 0.0;
     if (!c->moving) {
         /* Cheap rejection for a static triangle: the particle stays on one
          * side of its plane, farther than r at the end of the step. */
@@ -121,12 +122,16 @@ int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t partic
         const double *a = c->current + 3 * (size_t)c->triangles[3 * (size_t)t];
         double ds = (start[0] - a[0]) * n[0] + (start[1] - a[1]) * n[1] + (start[2] - a[2]) * n[2];
         double de = (end[0] - a[0]) * n[0] + (end[1] - a[1]) * n[1] + (end[2] - a[2]) * n[2];
-        if (ds * de > 0.0 && fabs(de) >= r) return 0;
+        if (ds * de > 0.0 && fabs(de) >= r) {
+            *end_d2 = de * de;
+            return 0;
+        }
     }
     triangle_motion(c, t, t0, t1, n0, n1);
     if (n1[0] == 0.0 && n1[1] == 0.0 && n1[2] == 0.0) return 0;
     double w[3], cp[3], offset[3], tc;
     double d2 = wci_point_triangle_closest(end, t1[0], t1[1], t1[2], w);
+    *end_d2 = d2;
     bary_point(t1[0], t1[1], t1[2], w, cp);
     for (int k = 0; k < 3; ++k) offset[k] = end[k] - cp[k];
     double side = side_of(start, t0[0], n0, offset, n1);

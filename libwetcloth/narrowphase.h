@@ -51,9 +51,13 @@
 /// collider at contact distance r. Returns 1 and fills the record (source,
 /// count 1 with the particle index `particle`, normal, distance, target r,
 /// surface motion, place; friction left to the caller) on a touch.
+/// *end_d2 gets a lower bound on the square of the particle's distance
+/// from the triangle at the end of the step (the exact one, or the distance
+/// from its plane where that already rules a touch out; 0 for a degenerate
+/// triangle): what a renewed snapshot may credit the pair with.
 int wci_narrow_particle_triangle(const wc_collider *col, int32_t t, int32_t particle,
                                 const double start[3], const double end[3], double r,
-                                wc_contact *out);
+                                double *end_d2, wc_contact *out);
 
 /// The same against a convex collider.
 int wci_narrow_particle_convex(const wc_collider *col, int32_t particle, const double start[3],
