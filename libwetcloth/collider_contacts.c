@@ -268,7 +268,7 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         }
         wci_candidates_local_motion(cand, &s->el, col, NULL, c->particle_count);
         for (int32_t i = 0; i < c->particle_count; ++i)
-            if (wc_candidates_half_used(cand, i, wci_candidates_displacement(cand, p, i)))
+            if (wc_candidates_rebase_due(cand, i, wci_candidates_displacement(cand, p, i)))
                 note_rebase(s, i);
         if (flush_rebase(s, col, k, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
     }
