@@ -41,7 +41,6 @@ void wci_collider_destroy(wc_collider *c)
     if (!c) return;
     wci_free(c->triangles);
     wci_free(c->edges);
-    wci_free(c->triangle_edges);
     wci_free(c->current);
     wci_free(c->target);
     wci_free(c->next);
@@ -60,10 +59,10 @@ void wci_collider_destroy(wc_collider *c)
     wci_free(c);
 }
 
-static int compare_triples(const void *pa, const void *pb)
+static int compare_pairs(const void *pa, const void *pb)
 {
     const int32_t *p = pa, *q = pb;
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 2; ++k)
         if (p[k] != q[k]) return p[k] < q[k] ? -1 : 1;
     return 0;
 }
@@ -80,39 +79,33 @@ static void used_vertices(wc_collider *c)
     c->used_vertex_count = n;
 }
 
-/* The unique edges of a mesh collider's triangles, sorted, and each
- * triangle's three edge ids. Entries (a, b, where) are
- * sorted so equal edges become neighbours; `where` is 3 * triangle + corner. */
+/* The unique edges of a mesh collider's triangles, sorted. Entries (a, b),
+ * a < b, are sorted so equal edges become neighbours. */
 static int build_edges(wc_collider *c)
 {
     size_t n = 3 * (size_t)c->triangle_count;
-    int32_t *entries = wci_alloc_array(3 * n, sizeof *entries);
+    int32_t *entries = wci_alloc_array(2 * n, sizeof *entries);
     c->edges = wci_alloc_array(2 * n, sizeof *c->edges);
-    c->triangle_edges = wci_alloc_array(n, sizeof *c->triangle_edges);
-    if (!entries || !c->edges || !c->triangle_edges) {
+    if (!entries || !c->edges) {
         wci_free(entries);
         return 0;
     }
     for (size_t t = 0; t < (size_t)c->triangle_count; ++t)
         for (int k = 0; k < 3; ++k) {
             int32_t a = c->triangles[3 * t + k], b = c->triangles[3 * t + (k + 1) % 3];
-            int32_t *e = entries + 3 * (3 * t + k);
-            e[0] = a < b ? a : b, e[1] = a < b ? b : a, e[2] = (int32_t)(3 * t + k);
+            int32_t *e = entries + 2 * (3 * t + k);
+            e[0] = a < b ? a : b, e[1] = a < b ? b : a;
         }
-    qsort(entries, n, 3 * sizeof *entries, compare_triples);
+    qsort(entries, n, 2 * sizeof *entries, compare_pairs);
     int32_t unique = 0;
     for (size_t k = 0; k < n; ++k) {
-        const int32_t *e = entries + 3 * k;
-        if (e[0] == e[1]) { /* a degenerate triangle's collapsed edge */
-            c->triangle_edges[e[2]] = -1;
-            continue;
-        }
+        const int32_t *e = entries + 2 * k;
+        if (e[0] == e[1]) continue; /* a degenerate triangle's collapsed edge */
         if (!unique || e[0] != c->edges[2 * unique - 2] || e[1] != c->edges[2 * unique - 1]) {
             c->edges[2 * unique] = e[0];
             c->edges[2 * unique + 1] = e[1];
             ++unique;
         }
-        c->triangle_edges[e[2]] = unique - 1;
     }
     c->edge_count = unique;
     wci_free(entries);
@@ -357,11 +350,9 @@ static wc_status index_mesh(wc_collider *c)
     advance_boxes(c, c->triangles, 3, c->triangle_count, c->boxes);
     advance_boxes(c, c->edges, 2, c->edge_count, c->edge_boxes);
     advance_boxes(c, c->used_vertices, 1, c->used_vertex_count, c->vertex_boxes);
-    if (index_boxes(&c->edge_bvh, c->edge_boxes, c->edge_count) ||
-        index_boxes(&c->vertex_bvh, c->vertex_boxes, c->used_vertex_count))
-        return WC_ERROR_OUT_OF_MEMORY;
-    if (c->bvh.node_count == 0) {
-        if (wci_bvh_create(&c->bvh, c->boxes, c->triangle_count)) return WC_ERROR_OUT_OF_MEMORY;
+    int first = c->bvh.node_count == 0;
+    if (index_boxes(&c->bvh, c->boxes, c->triangle_count)) return WC_ERROR_OUT_OF_MEMORY;
+    if (first) {
         double total = 0.0;
         for (int32_t e = 0; e < c->edge_count; ++e) {
             const double *a = c->current + 3 * (size_t)c->edges[2 * (size_t)e];
@@ -370,9 +361,11 @@ static wc_status index_mesh(wc_collider *c)
             total += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         }
         c->feature_size = c->edge_count ? total / c->edge_count : 0.0;
-    } else {
-        wci_bvh_refit(&c->bvh);
     }
+    /* (a tree that could not be made is made at the next call) */
+    if (index_boxes(&c->edge_bvh, c->edge_boxes, c->edge_count) ||
+        index_boxes(&c->vertex_bvh, c->vertex_boxes, c->used_vertex_count))
+        return WC_ERROR_OUT_OF_MEMORY;
     memcpy(c->bounds, c->bvh.nodes[0].box, sizeof c->bounds);
     c->indexed = 1;
     return WC_OK;

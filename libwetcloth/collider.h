@@ -40,11 +40,10 @@ typedef struct wc_collider {
     int32_t vertex_count;
     int32_t triangle_count;
     int32_t *triangles;
-    /// Unique edges of the triangles, 2 vertex indices each, and the 3 edge
-    /// ids of each triangle (-1 for a degenerate triangle's collapsed edge).
+    /// Unique edges of the triangles, 2 vertex indices each (a degenerate
+    /// triangle's collapsed edge left out), ascending.
     int32_t edge_count;
     int32_t *edges;
-    int32_t *triangle_edges;
     /// Vertex positions now, xyz per vertex.
     double *current;
     /// Vertex positions at the end of the running advance.
