@@ -59,15 +59,22 @@ struct wc_implicit_state {
     /// that a thread that starts the next sum cannot overwrite one that
     /// another thread has not yet added up.
     double *partial;
-    /// Per link, scratch of the product with the matrix: B (in_a - in_b).
-    double *link_product;
     /// The links whose block is not zero in this step (a slack stretch link
     /// without a dashpot, a bend link that is not compressed: about half of
-    /// a draped cloth's), in index order, and per particle the entries of
-    /// its link list (cloth.h) that refer to them, in the list's order, at
-    /// the list's own offsets (`row_count` of them). The product visits only
-    /// these: the others would add exact zeros.
-    int32_t *active, active_count, *row_list, *row_count;
+    /// a draped cloth's), in index order: `active_count` of them, each with
+    /// a copy of its block and its ends, packed, so that an iteration reads
+    /// them in one sweep of memory instead of picking them out of all the
+    /// links' arrays; per link its place among them (`active_slot`, -1 for
+    /// a zero block); and per particle the entries of its link list
+    /// (cloth.h) that refer to them, in the list's order, at the list's own
+    /// offsets (`row_count` of them), as places (slot k, ~k at its second
+    /// end). The product visits only these: the others would add exact
+    /// zeros.
+    int32_t active_count, *active_slot, *active_a, *active_b, *row_list, *row_count;
+    double *active_block;
+    /// Per active link, scratch of the product with the matrix:
+    /// B (in_a - in_b).
+    double *link_product;
     /// The preconditioner's coarse levels; NULL for a cloth too small to
     /// gain from them (multigrid.h).
     wc_multigrid *multigrid;
@@ -80,11 +87,13 @@ void wci_implicit_state_destroy(wc_implicit_state *s)
     if (!s) return;
     double *arrays[] = {s->block, s->kv, s->mass_diag, s->precond, s->v0, s->fixed, s->rhs,
                         s->y, s->r, s->r_next, s->z, s->p, s->q, s->partial,
-                        s->link_product};
+                        s->link_product, s->active_block};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wci_free(arrays[i]);
     wci_free(s->end_a);
     wci_free(s->end_b);
-    wci_free(s->active);
+    wci_free(s->active_slot);
+    wci_free(s->active_a);
+    wci_free(s->active_b);
     wci_free(s->row_list);
     wci_free(s->row_count);
     wci_multigrid_destroy(s->multigrid);
@@ -113,11 +122,15 @@ wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
         ok &= (*vectors[i] = wci_alloc_array(3 * n, sizeof(double))) != NULL;
     s->partial = wci_alloc_array(PARTIAL_SETS * (size_t)s->blocks, sizeof(double));
     s->link_product = wci_alloc_array(3 * links + 1, sizeof(double));
-    s->active = wci_alloc_array(links + 1, sizeof *s->active);
+    s->active_slot = wci_alloc_array(links + 1, sizeof *s->active_slot);
+    s->active_a = wci_alloc_array(links + 1, sizeof *s->active_a);
+    s->active_b = wci_alloc_array(links + 1, sizeof *s->active_b);
+    s->active_block = wci_alloc_array(6 * links + 1, sizeof(double));
     s->row_list = wci_alloc_array((size_t)c->link_start[n] + 1, sizeof *s->row_list);
     s->row_count = wci_alloc_array(n + 1, sizeof *s->row_count);
     if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
-        !s->partial || !s->link_product || !s->active || !s->row_list || !s->row_count) {
+        !s->partial || !s->link_product || !s->active_slot ||
+        !s->active_a || !s->active_b || !s->active_block || !s->row_list || !s->row_count) {
         wci_implicit_state_destroy(s);
         return NULL;
     }
@@ -194,6 +207,11 @@ static void set_block(double *b, double along, double across, double ux, double 
  *     the ends apart, so that term is negative and would make M - h^2 df/dx
  *     indefinite (Choi & Ko 2002, section 4.2);
  *   stretch dashpots: C = c u u^T, taut or slack, as in forces.c. */
+/* d^2 > STRETCHED_CLEARLY l^2 means d > l whatever the rounding of d^2,
+ * l^2 and sqrt (each within a relative 2^-52 or so): a bend link that
+ * passes it is longer than at rest, and not compressed. */
+#define STRETCHED_CLEARLY (1.0 + 1e-9)
+
 static int link_blocks_range(void *context, int64_t begin, int64_t end)
 {
     const implicit_pass *pass = context;
@@ -206,7 +224,19 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
     for (int64_t e = begin; e < end; ++e) {
         int32_t a = s->end_a[e], b = s->end_b[e];
         double dx = c->x[a] - c->x[b], dy = c->y[a] - c->y[b], dz = c->z[a] - c->z[b];
-        double d = sqrt(dx * dx + dy * dy + dz * dz);
+        double d2 = dx * dx + dy * dy + dz * dz;
+        double *kv = s->kv + 3 * (size_t)e, *blk = s->block + 6 * (size_t)e;
+        if (e >= ns && d2 > STRETCHED_CLEARLY * bd->rest[e - ns] * bd->rest[e - ns]) {
+            /* a bend link that is not compressed has no stiffness: the
+             * block the general path below would make is zero, without
+             * its square root and divisions (most bend links of a draped
+             * cloth) */
+            set_block(blk, 0.0, 0.0, 0.0, 0.0, 0.0);
+            wc_sym3_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
+                          v0[3 * a + 2] - v0[3 * b + 2], kv);
+            continue;
+        }
+        double d = sqrt(d2);
         double along = 0.0, across = 0.0, damp = 0.0;
         double ux = 0.0, uy = 0.0, uz = 0.0;
         if (d > 0.0) ux = dx / d, uy = dy / d, uz = dz / d;
@@ -219,7 +249,6 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
             along = buckling_slope(d, bd->rest[f], c->bend_r[f]);
             if (!(d > 0.0)) along = 0.0;
         }
-        double *kv = s->kv + 3 * (size_t)e, *blk = s->block + 6 * (size_t)e;
         set_block(blk, along, across, ux, uy, uz);
         wc_sym3_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
                     v0[3 * a + 2] - v0[3 * b + 2], kv);
@@ -233,7 +262,8 @@ static int block_is_zero(const double *b)
     return b[0] == 0.0 && b[1] == 0.0 && b[2] == 0.0 && b[3] == 0.0 && b[4] == 0.0 && b[5] == 0.0;
 }
 
-/* Each particle's entries of the links with a block, in its list's order. */
+/* Each particle's entries of the links with a block, in its list's order,
+ * as their places among the active links. */
 static int rows_range(void *context, int64_t begin, int64_t end)
 {
     const implicit_pass *pass = context;
@@ -242,21 +272,32 @@ static int rows_range(void *context, int64_t begin, int64_t end)
     for (int64_t i = begin; i < end; ++i) {
         int32_t *row = s->row_list + c->link_start[i], count = 0;
         for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
-            int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
-            if (!block_is_zero(s->block + 6 * (size_t)e)) row[count++] = entry;
+            int32_t entry = c->link_list[k];
+            int32_t slot = s->active_slot[entry >= 0 ? entry : ~entry];
+            if (slot >= 0) row[count++] = entry >= 0 ? slot : ~slot;
         }
         s->row_count[i] = count;
     }
     return 0;
 }
 
-/* The links the product visits (the state's `active`), after the blocks. */
+/* The links the product visits, packed (the state's `active_*`), after the
+ * blocks. */
 static void active_links(const implicit_pass *pass, int threads)
 {
     wc_implicit_state *s = pass->state;
     int32_t count = 0;
-    for (int32_t e = 0; e < s->links; ++e)
-        if (!block_is_zero(s->block + 6 * (size_t)e)) s->active[count++] = e;
+    for (int32_t e = 0; e < s->links; ++e) {
+        const double *blk = s->block + 6 * (size_t)e;
+        if (block_is_zero(blk)) {
+            s->active_slot[e] = -1;
+            continue;
+        }
+        s->active_slot[e] = count;
+        s->active_a[count] = s->end_a[e], s->active_b[count] = s->end_b[e];
+        memcpy(s->active_block + 6 * (size_t)count, blk, 6 * sizeof(double));
+        ++count;
+    }
     s->active_count = count;
     wci_parallel_for(s->n, wc_threads_for(s->n, threads), rows_range, (void *)pass);
 }
@@ -381,10 +422,9 @@ static int link_products_range(void *context, int64_t begin, int64_t end)
     wc_implicit_state *s = pass->state;
     const double *in = pass->in;
     for (int64_t k = begin; k < end; ++k) {
-        int32_t e = s->active[k];
-        const double *va = in + 3 * (size_t)s->end_a[e], *vb = in + 3 * (size_t)s->end_b[e];
-        wc_sym3_times(s->block + 6 * (size_t)e, va[0] - vb[0], va[1] - vb[1], va[2] - vb[2],
-                      s->link_product + 3 * (size_t)e);
+        const double *va = in + 3 * (size_t)s->active_a[k], *vb = in + 3 * (size_t)s->active_b[k];
+        wc_sym3_times(s->active_block + 6 * (size_t)k, va[0] - vb[0], va[1] - vb[1],
+                      va[2] - vb[2], s->link_product + 3 * (size_t)k);
     }
     return 0;
 }
