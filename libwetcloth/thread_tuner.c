@@ -24,6 +24,13 @@
 /* More threads must be this much faster to be taken (they cost the rest of
  * the machine more); fewer are taken when they are no slower. */
 #define MORE_THREADS_GAIN 0.97
+/* A probed count's step that takes more than this many times the chosen
+ * count's steps of the same probe ends the probe at once, lost: it cannot
+ * win (it must be faster in both halves), and on a machine with a core
+ * busy one such step on two threads took 30-140 times one on one thread
+ * (a 961-particle drape: a 4-step probe cost 60-75 ms against 0.5 ms per
+ * step). */
+#define ABANDON 2.0
 
 /* A probe runs the chosen count (A) and the probed one (B) in the order
  * A B B A, twice: within each block both get the same sum of step
@@ -75,6 +82,25 @@ static void start_probe(wc_thread_tuner *t)
     t->current = t->chosen; /* PROBE_ORDER[0] */
 }
 
+/* After a lost probe: the next one comes after twice the period (up to
+ * BACKOFF_PERIOD), or later still when this one cost much, so that lost
+ * probes cost about PROBE_COST of the time; `extra` is what the probed
+ * count's steps took beyond the chosen count's, in chosen-count steps. */
+static void back_off(wc_thread_tuner *t, double extra)
+{
+    double wait = extra / PROBE_COST;
+    int32_t period = 2 * t->period < BACKOFF_PERIOD ? 2 * t->period : BACKOFF_PERIOD;
+    if (wait > period) period = wait < MAX_PERIOD ? (int32_t)wait : MAX_PERIOD;
+    t->period = period;
+}
+
+static void finish_probe(wc_thread_tuner *t)
+{
+    t->probed = 0;
+    t->current = t->chosen;
+    t->until_probe = t->period;
+}
+
 static void end_probe(wc_thread_tuner *t)
 {
     double gain = t->probed < t->chosen ? 1.0 : MORE_THREADS_GAIN;
@@ -86,26 +112,39 @@ static void end_probe(wc_thread_tuner *t)
         t->recent_count = t->recent_next = 0;
         t->period = FIRST_PERIOD;
     } else {
-        /* the probed count's extra time per step, in chosen-count steps */
+        /* the probed count's extra time, in chosen-count steps (half the
+         * probe's steps were on each count) */
         double chosen = t->block_chosen[0] + t->block_chosen[1];
-        double extra = chosen > 0.0 ? (t->block_probed[0] + t->block_probed[1]) / chosen - 1.0
-                                    : 0.0;
-        double wait = 0.5 * WC_TUNER_PROBE_STEPS * extra / PROBE_COST;
-        int32_t period = 2 * t->period < BACKOFF_PERIOD ? 2 * t->period : BACKOFF_PERIOD;
-        if (wait > period) period = wait < MAX_PERIOD ? (int32_t)wait : MAX_PERIOD;
-        t->period = period;
+        double probed = t->block_probed[0] + t->block_probed[1];
+        double steps = 0.5 * WC_TUNER_PROBE_STEPS;
+        back_off(t, chosen > 0.0 ? steps * (probed / chosen - 1.0) : 0.0);
     }
-    t->probed = 0;
-    t->current = t->chosen;
-    t->until_probe = t->period;
+    finish_probe(t);
+}
+
+/* The mean time of the probe's steps on the chosen count so far. */
+static double chosen_step_time(const wc_thread_tuner *t)
+{
+    int32_t steps = 0;
+    for (int32_t k = 0; k < t->probe_step; ++k) steps += !PROBE_ORDER[k];
+    return steps ? (t->block_chosen[0] + t->block_chosen[1]) / steps : 0.0;
 }
 
 static void record_probe_step(wc_thread_tuner *t, double seconds)
 {
-    int32_t block = t->probe_step / 4;
-    if (PROBE_ORDER[t->probe_step]) t->block_probed[block] += seconds;
+    int32_t block = t->probe_step / 4, probed = PROBE_ORDER[t->probe_step];
+    if (probed) t->block_probed[block] += seconds;
     else t->block_chosen[block] += seconds;
-    if (++t->probe_step == WC_TUNER_PROBE_STEPS) {
+    ++t->probe_step;
+    double chosen = chosen_step_time(t);
+    if (probed && chosen > 0.0 && seconds > ABANDON * chosen) {
+        /* clearly lost: no more of its steps (under load one of them can
+         * take tens of the chosen count's) */
+        back_off(t, seconds / chosen - 1.0);
+        finish_probe(t);
+        return;
+    }
+    if (t->probe_step == WC_TUNER_PROBE_STEPS) {
         end_probe(t);
         return;
     }

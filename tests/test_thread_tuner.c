@@ -76,6 +76,45 @@ static void busy_core_moves_to_one_and_back(void)
     CHECK(idle.steps_at[2] > 2500, "idle again: only %d steps on 2 threads", idle.steps_at[2]);
 }
 
+/* A probe whose first step on the probed count takes more than twice the
+ * chosen count's ends there, lost: one step on the slow count, not four,
+ * and the next probe waits until that step's extra cost is 5 % of the
+ * steps between (here 100 ms extra = 5 chosen steps, so 100 steps, more
+ * than the doubled period of 64). A probe that is merely slower runs all
+ * its steps. */
+static void clearly_lost_probe_ends_at_once(void)
+{
+    wc_thread_tuner t;
+    wci_thread_tuner_create(&t, 2, 1);
+    int32_t on_two = 0, steps = 0;
+    while (!t.probed) {
+        wci_thread_tuner_record(&t, 0.020);
+        ++steps;
+    }
+    /* 2 of warm-up, 2 more to fill the samples, then FIRST_PERIOD */
+    CHECK(steps == 36, "probe after %d steps", (int)steps);
+    for (int k = 0; k < 8 && (t.probed || k == 0); ++k) {
+        int32_t n = wci_thread_tuner_threads(&t);
+        on_two += n == 2;
+        wci_thread_tuner_record(&t, n == 2 ? 0.120 : 0.020);
+    }
+    CHECK(on_two == 1 && t.probed == 0 && t.chosen == 1 && wci_thread_tuner_threads(&t) == 1,
+          "%d steps on 2 threads, probing %d, chosen %d", (int)on_two, (int)t.probed, (int)t.chosen);
+    CHECK(t.until_probe == 100 && t.period == 100, "next probe in %d, period %d",
+          (int)t.until_probe, (int)t.period);
+    /* 1.5 times slower: not clearly lost, the probe runs its 4 steps */
+    wci_thread_tuner_create(&t, 2, 1);
+    while (!t.probed) wci_thread_tuner_record(&t, 0.020);
+    on_two = 0;
+    while (t.probed) {
+        int32_t n = wci_thread_tuner_threads(&t);
+        on_two += n == 2;
+        wci_thread_tuner_record(&t, n == 2 ? 0.030 : 0.020);
+    }
+    CHECK(on_two == 4 && t.chosen == 1, "%d steps on 2 threads, chosen %d", (int)on_two,
+          (int)t.chosen);
+}
+
 /* The machine gets busy after the tuner had settled on 2 threads with a
  * long probe period: the slowdown brings the probe forward. */
 static void slowdown_brings_the_probe_forward(void)
@@ -182,6 +221,7 @@ int main(void)
 {
     idle_machine_keeps_two();
     busy_core_moves_to_one_and_back();
+    clearly_lost_probe_ends_at_once();
     slowdown_brings_the_probe_forward();
     sixteen_threads_find_the_free_cores();
     ties_go_to_fewer_threads();

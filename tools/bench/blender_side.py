@@ -9,19 +9,17 @@ the 114-vertex UV sphere (16 x 8, radius 0.3 m), 24 fps. Blender: the Cloth
 modifier with its defaults and quality 5 (5 steps per frame), the sphere with
 a Collision modifier, self-collision on or off; the frames are evaluated in
 order with scene.frame_set. Ours: the same geometry with the default
-material, automatic substeps. Both in this process, one after the other, 1
-thread for ours (Blender uses its own thread pool). The materials are not
-the same (Blender's defaults against our cotton): the ratio compares what a
-user gets from each with default settings on this scene.
+material and the default integrator at automatic substeps, World()'s
+defaults. Both in this process, one after the other: ours on 1 thread, and
+again with the default thread count (0: every core, adapt_threads on), which
+is what a user gets; Blender uses its own thread pool on the same cores. The
+materials are not the same (Blender's defaults against our cotton): the
+ratio compares what a user gets from each with default settings on this
+scene.
 
-Frames: 48 up to 20 x 20, 24 up to 60 x 60,
-12 beyond. What makes the large sizes slow is our error's reference, not
-Blender nor our run: at 101 x 101 our default (Verlet, automatic substeps)
-takes ~600 substeps per frame and the reference 8x that, ~4,800 steps of a
-10,201-particle cloth per frame (measured 4.7-7.8 ms per step under load 8
-on the shared 2-core machine: ~15 min per 24 frames for each of the two
-self-collision settings). 12 frames (0.5 s: the cloth reaches the sphere at
-0.25 s and drapes) keep the 101 x 101 rows within ~15 minutes in all.
+Frames: 48 up to 20 x 20, 24 up to 60 x 60, 12 beyond (0.5 s: the cloth
+reaches the sphere at 0.25 s and drapes); what makes the large sizes slow is
+Blender with self-collision and our error's reference (8x our substeps).
 
 Reported: wall time per simulated frame of each and their ratio; our error
 (RMS over particles and frames of the distance to our reference, Verlet at
@@ -102,11 +100,13 @@ def blender_run(n, self_collision, frames):
     return wall, k, bool(np.all(np.isfinite(pos)))
 
 
-def ours(n, self_collision, frames, substeps=0):
+def ours(n, self_collision, frames, substeps=0, threads=1):
     """Our run: wall s per frame, positions per frame, intersections at the
     end, substeps per frame, and its fastest particle at any frame's end,
-    m/s (a sanity figure for the reference)."""
-    w, c = scenes.drape(n, self_collision=self_collision, threads=1)
+    m/s (a sanity figure for the reference). threads=0: the default count
+    (every core, adapt_threads on); the positions are the same bits for any
+    count."""
+    w, c = scenes.drape(n, self_collision=self_collision, threads=threads)
     out, wall, fastest = [], 0.0, 0.0
     for _ in range(frames):
         t0 = time.perf_counter()
@@ -135,28 +135,38 @@ def main():
     print(f"bpy {bpy.app.version_string}, libwetcloth {wetcloth.__version__}; load average "
           f"before: {' '.join(open('/proc/loadavg').read().split()[:3])}.")
     print()
-    print("| particles | self-collision | frames | Blender ms/frame | ours ms/frame | Blender / ours "
+    cores = os.cpu_count()
+    print(f"Ours on 1 thread, and with the default thread count (every core: {cores} here, "
+          "adapt_threads on); Blender on its own thread pool.")
+    print()
+    print("| particles | self-collision | frames | Blender ms/frame | ours ms/frame, 1 thread "
+          "| Blender / ours, 1 thread | ours ms/frame, default threads | Blender / ours, default threads "
           "| our substeps/frame | our error / size | intersections ours (cloth-cloth, cloth-sphere) "
           "| intersections Blender | lowest point at the end, ours / reference, m "
           "| fastest particle, ours / reference, m/s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for n, frames in cases:
         for self_c in (True, False):
             bw, bk, bfinite = blender_run(n, self_c, frames)
             ow, opos, ok, sub, ofast = ours(n, self_c, frames)
-            _, rpos, _, _, rfast = ours(n, self_c, frames, 8 * sub)
+            tw, tpos, _, _, _ = ours(n, self_c, frames, threads=0)
+            if not np.array_equal(tpos, opos):
+                raise SystemExit(f"{n}: positions differ between 1 thread and the default count")
+            _, rpos, _, _, rfast = ours(n, self_c, frames, 8 * sub, threads=0)
             d = np.linalg.norm(opos - rpos, axis=2)
             err = float(np.sqrt(np.mean(d * d)))
             row = {"particles": n * n, "self": self_c, "frames": frames, "blender_s": bw,
-                   "ours_s": ow, "ratio": bw / ow, "substeps": sub, "error": err,
+                   "ours_s": ow, "ratio": bw / ow, "ours_default_threads_s": tw,
+                   "ratio_default_threads": bw / tw, "substeps": sub, "error": err,
                    "ours_intersections": ok, "blender_intersections": bk,
                    "blender_finite": bfinite, "lowest": float(opos[-1, :, 2].min()),
                    "reference_lowest": float(rpos[-1, :, 2].min()), "fastest": ofast,
                    "reference_fastest": rfast}
             rows.append(row)
             print(f"| {n * n} | {'on' if self_c else 'off'} | {frames} | {1e3 * bw:.3g} | "
-                  f"{1e3 * ow:.3g} | {bw / ow:.2f} | {sub} | {err:.2e} | "
+                  f"{1e3 * ow:.3g} | {bw / ow:.2f} | {1e3 * tw:.3g} | {bw / tw:.2f} | {sub} | "
+                  f"{err:.2e} | "
                   f"{ok['cloth_cloth']}, {ok['cloth_collider']} | "
                   f"{bk['cloth_cloth']}, {bk['cloth_collider']} | {row['lowest']:.3f} / "
                   f"{row['reference_lowest']:.3f} | {ofast:.3g} / {rfast:.3g} |", flush=True)

@@ -58,7 +58,21 @@ sys.path.insert(0, HERE)
 # loads): on a shared machine a spinning thread that is descheduled holds
 # every barrier of a 2-thread step for a scheduler tick (measured: 0.1 s per
 # step of a 4096-particle cloth at load 8, 2 threads, against 0.5 ms with 1).
+# The sections that measure what a user gets on several threads (Blender side
+# by side, threads under load) run their programs with the policy this
+# program was started with (user_env), the library's default unless set.
+USER_WAIT_POLICY = os.environ.get("OMP_WAIT_POLICY")
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+
+
+def user_env():
+    """The environment with OMP_WAIT_POLICY as the user had it."""
+    env = dict(os.environ)
+    if USER_WAIT_POLICY is None:
+        env.pop("OMP_WAIT_POLICY", None)
+    else:
+        env["OMP_WAIT_POLICY"] = USER_WAIT_POLICY
+    return env
 
 import wetcloth  # noqa: E402
 
@@ -478,7 +492,7 @@ def blender(out, quick, python, lines, sizes=None):
     if not python or not os.path.exists(python):
         lines += [f"Skipped: no Python with bpy ({python}).", ""]
         return None
-    env = dict(os.environ)
+    env = user_env()
     import cffi  # the bpy environment has numpy<2 but no cffi: lend it ours
     import tempfile
     lend = tempfile.mkdtemp(prefix="wc-bench-cffi-")
@@ -584,6 +598,68 @@ def other_programs(build, quick, lines):
         lines += [text, "", f"`{name} {' '.join(args)}`:", ""] + r.stdout.rstrip().splitlines() + [""]
 
 
+def busy_core():
+    """Another process that keeps one core busy, as a renderer or a browser
+    does on an artist's machine."""
+    return subprocess.Popen([sys.executable, "-c", "while True: pass"])
+
+
+def threads_under_load(build, quick, lines):
+    """The 10,201-particle drape at the default integrator and steps on 1
+    thread, 2 fixed threads and 2 adaptive ones (the default), on the
+    machine as it is and with another process keeping one core busy;
+    alternated, each setting `repeats` times. bench_integrators runs with
+    the user's OpenMP wait policy (the library's default unless set)."""
+    lines += ["## Threads under load", ""]
+    program = os.path.join(build, "tools", "bench_integrators")
+    if not os.path.exists(program):
+        lines += [f"Skipped: no bench_integrators program ({program}).", ""]
+        return None
+    size, repeats, seconds = (31, 1, "0.25") if quick else (101, 3, "0.5")
+    settings = [("1 thread", 1, 0), ("2 threads, adapt_threads=0", 2, 0),
+                ("2 threads, adapt_threads=1 (the default)", 2, 1)]
+    args = [f"sizes={size}", "self=0", "integrators=implicit", "steps=12", f"seconds={seconds}",
+            "reference=0"]
+    command = f"build/tools/bench_integrators {' '.join(args)} threads=T adapt=A"
+    lines += [f"{size} x {size} cloth ({size * size} particles), the thesis drape, the implicit "
+              f"integrator at 12 steps per frame, self-collision off, {seconds} s simulated; "
+              f"`{command}`, the settings alternated, {repeats} run(s) each, wall ms per "
+              f"simulated frame (range over the runs). \"One core busy\": another process "
+              f"spins on one core meanwhile (`python -c 'while True: pass'`). "
+              f"OMP_WAIT_POLICY: {USER_WAIT_POLICY or 'unset (the default)'}; "
+              f"{os.cpu_count()} cores; load average before: {load()}.", ""]
+    results = {}
+    for condition in ("idle", "busy"):
+        spinner = busy_core() if condition == "busy" else None
+        try:
+            for _ in range(repeats):
+                for label, threads, adapt in settings:
+                    r = subprocess.run([program] + args + [f"threads={threads}", f"adapt={adapt}"],
+                                       capture_output=True, text=True, env=user_env())
+                    if r.returncode != 0:
+                        raise SystemExit("bench_integrators failed:\n" + r.stdout[-2000:] + r.stderr[-2000:])
+                    row = [l.split() for l in r.stdout.splitlines()
+                           if l.split() and l.split()[0] == str(size * size) and len(l.split()) > 10]
+                    results.setdefault(condition, {}).setdefault(label, []).append(float(row[0][4]))
+        finally:
+            if spinner:
+                spinner.kill()
+                spinner.wait()
+    lines += ["| setting | machine as it is, ms/frame | one core busy, ms/frame | 1 thread / it, as it is "
+              "| 1 thread / it, one core busy |", "|---|---|---|---|---|"]
+    one = {c: min(results[c]["1 thread"]) for c in results}
+    for label, _, _ in settings:
+        cells = []
+        for c in ("idle", "busy"):
+            v = results[c][label]
+            cells.append(f"{min(v):.0f}-{max(v):.0f}" if len(v) > 1 else f"{v[0]:.0f}")
+        ratios = [f"{one[c] / min(results[c][label]):.2f}" for c in ("idle", "busy")]
+        lines += [f"| {label} | {cells[0]} | {cells[1]} | {ratios[0]} | {ratios[1]} |"]
+    lines += ["", "The ratios divide the fastest 1-thread run by the fastest run of the setting "
+              "(above 1: faster than one thread). Load average after: " + load() + ".", ""]
+    return results
+
+
 def hard_cases(program, lines):
     lines += ["## Hard cases", "",
               "tests/test_hard_cases.c (a ctest test; each case with its pass criterion: finite, a "
@@ -615,7 +691,7 @@ def main():
     ap.add_argument("--only", default="", help="comma-separated sections to run (the others' "
                     "parts already in --out are kept)")
     ap.add_argument("--skip", default="", help="comma-separated sections to skip: "
-                    "speed,closed,scaling,blender,table,hard,other,contacts")
+                    "speed,closed,scaling,blender,table,hard,other,contacts,threads")
     ap.add_argument("--contacts-base", help="build folder of the commit before the contact "
                     "stage, for the contacts section's \"before\" columns")
     a = ap.parse_args()
@@ -653,6 +729,7 @@ def main():
         ("hard", lambda L: hard_cases(a.hard_cases, L) if not a.quick else None),
         ("other", lambda L: other_programs(a.build, a.quick, L)),
         ("contacts", lambda L: contacts(a.out, a.quick, a.blender_python, a.build, a.contacts_base, L)),
+        ("threads", lambda L: threads_under_load(a.build, a.quick, L)),
     ]
     only = set(filter(None, a.only.split(",")))
     for k, (name, fn) in enumerate(sections):
