@@ -3,15 +3,21 @@
 #include "invariant.h"
 #include "vec3.h"
 
-/* A world starts on one thread and first tries more after FIRST_PERIOD
+/* A world starts on one thread and first tries more after FIRST_PROBE
  * steps: on a busy machine a step on more threads can take many times
- * longer (15x was measured here, at 4 runnable processes on 2 cores), and
- * a start on one costs an idle machine only those first steps at its
- * single-thread speed. Probes then come every FIRST_PERIOD steps, backing
+ * longer (15x was measured here, at 4 runnable processes on 2 cores, and
+ * 40-80x for a 961-particle drape with one core busy), and a start on one
+ * costs an idle machine only those first steps at its single-thread speed.
+ * The first probe comes early because a probe that is clearly lost ends
+ * after one step (ABANDON): on a busy machine it costs that one step
+ * whenever it comes, and on an idle one the steps before it run on one
+ * thread (with 32, a quarter of a 12-frame run at 12 steps per frame).
+ * Probes then come every FIRST_PERIOD steps, backing
  * off to BACKOFF_PERIOD while the chosen count keeps winning (so a machine
  * that becomes free again is used within that many steps), and never more
  * often than keeps a lost probe's cost (its 4 steps on the slower count)
  * to about PROBE_COST of the steps between probes, up to MAX_PERIOD. */
+#define FIRST_PROBE 8
 #define FIRST_PERIOD 32
 #define BACKOFF_PERIOD 1024
 #define MAX_PERIOD 4096
@@ -50,7 +56,8 @@ void wci_thread_tuner_create(wc_thread_tuner *t, int32_t most, int32_t adapt)
     t->adapt = adapt && t->most > 1;
     t->chosen = t->current = t->adapt ? 1 : t->most;
     t->probed = 0;
-    t->period = t->until_probe = FIRST_PERIOD;
+    t->period = FIRST_PERIOD;
+    t->until_probe = FIRST_PROBE;
     t->direction = 1;
     t->warmup = 2;
     t->recent_count = t->recent_next = t->probe_step = 0;

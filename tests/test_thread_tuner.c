@@ -52,9 +52,11 @@ static void idle_machine_keeps_two(void)
     run_log log = drive(&t, 5000, 2, 0.020, 0.004);
     printf("idle 2 cores: %d steps on 2 threads, %d on 1\n", log.steps_at[2], log.steps_at[1]);
     CHECK(log.last == 2, "ended on %d threads", log.last);
-    /* the first 32 steps (and the 2 of warm-up), then probes of 4 steps,
-     * the period doubling to 1024: 9 probes in 5000 steps */
-    CHECK(log.steps_at[1] <= 34 + 3 + 4 * 9, "%d steps on 1 thread", log.steps_at[1]);
+    /* the first 12 steps (2 of warm-up, 2 more to fill the samples, 8
+     * before the first probe) and that probe's 4 on one thread, then
+     * probes of 4 steps on 1, the period doubling from 32 to 1024: 8 of
+     * them in 5000 steps */
+    CHECK(log.steps_at[1] <= 12 + 4 + 4 * 8, "%d steps on 1 thread", log.steps_at[1]);
     CHECK(t.period == 1024, "period %d", (int)t.period);
 }
 
@@ -91,8 +93,8 @@ static void clearly_lost_probe_ends_at_once(void)
         wci_thread_tuner_record(&t, 0.020);
         ++steps;
     }
-    /* 2 of warm-up, 2 more to fill the samples, then FIRST_PERIOD */
-    CHECK(steps == 36, "probe after %d steps", (int)steps);
+    /* 2 of warm-up, 2 more to fill the samples, then FIRST_PROBE */
+    CHECK(steps == 12, "probe after %d steps", (int)steps);
     for (int k = 0; k < 8 && (t.probed || k == 0); ++k) {
         int32_t n = wci_thread_tuner_threads(&t);
         on_two += n == 2;
