@@ -788,8 +788,10 @@ def main():
     if results.get("hard_cases_exit_code"):
         failures.append("test_hard_cases failed")
     for row in results.get("blender") or []:
+        # without self-collision a cloth may pass through itself (Blender's
+        # does too); through the collider never
         k = row["ours_intersections"]
-        if k["cloth_cloth"] or k["cloth_collider"]:
+        if (row["self"] and k["cloth_cloth"]) or k["cloth_collider"]:
             failures.append(f"drape {row['particles']}: our cloth ends with intersections {k}")
     lines += ["Checks: " + ("all passed." if not failures else "FAILED: " + "; ".join(failures)), ""]
     lines += [f"Load average at the end: {load()}; this run took "
