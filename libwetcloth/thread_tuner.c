@@ -6,7 +6,7 @@
 /* A world starts on one thread and first tries more after FIRST_PROBE
  * steps: on a busy machine a step on more threads can take many times
  * longer (15x was measured here, at 4 runnable processes on 2 cores, and
- * 40-80x for a 961-particle drape with one core busy), and a start on one
+ * tens of times for a 961-particle drape with one core busy), and a start on one
  * costs an idle machine only those first steps at its single-thread speed.
  * The first probe comes early because a probe that is clearly lost ends
  * after one step (ABANDON): on a busy machine it costs that one step
@@ -33,9 +33,10 @@
 /* A probed count's step that takes more than this many times the chosen
  * count's steps of the same probe ends the probe at once, lost: it cannot
  * win (it must be faster in both halves), and on a machine with a core
- * busy one such step on two threads took 30-140 times one on one thread
- * (a 961-particle drape: a 4-step probe cost 60-75 ms against 0.5 ms per
- * step). */
+ * busy one step on two threads took tens of times one on one thread (a
+ * 961-particle drape at 12 steps per frame: the frame that held a whole
+ * 4-step probe took 65-80 ms against 5.5-6, one that ends it after its
+ * first step 46-49). */
 #define ABANDON 2.0
 
 /* A probe runs the chosen count (A) and the probed one (B) in the order

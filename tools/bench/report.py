@@ -26,12 +26,17 @@ none is edited by hand):
    without self-collision, 1 and 2 threads, log-log chart with the fitted
    slope of wall time per step against particles.
 4. Blender side by side (tools/bench/blender_side.py, run under the Python
-   that has bpy, .venv-blender): Blender's cloth (quality 5) and ours on
+   that has bpy, .venv-blender): Blender's cloth (quality 5) and ours (at
+   World()'s defaults, on 1 thread and on the default thread count) on
    the grid cloth onto the 114-vertex sphere.
 5. the thesis' Table 3.2 next to ours (the output of bench_collide);
 6. (full mode) the hard cases: the output of tests/test_hard_cases;
 7. the core step without collisions (bench_core) and the cost of wetness
-   (bench_wet).
+   (bench_wet);
+8. the contact stage's scenes side by side with Blender (contacts_side.py);
+9. threads under load: the 10,201-particle drape on 1 thread, 2 fixed and
+   2 adaptive ones, on the machine as it is and with another process
+   spinning on one core.
 
 Environment: the wetcloth package must be importable (PYTHONPATH=<build>/python,
 the staged package of a build, or an installed one); --bench-collide names
