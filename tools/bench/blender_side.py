@@ -106,13 +106,14 @@ def blender_run(n, self_collision, frames):
     return wall, k, bool(np.all(np.isfinite(pos)))
 
 
-def ours(n, self_collision, frames, substeps=0, threads=1):
+def ours(n, self_collision, frames, substeps=0, threads=1, adapt=True):
     """Our run: wall s per frame, positions per frame, intersections at the
     end, substeps per frame, and its fastest particle at any frame's end,
     m/s (a sanity figure for the reference). threads=0: the default count
-    (every core, adapt_threads on); the positions are the same bits for any
-    count."""
-    w, c = scenes.drape(n, DEFAULT_INTEGRATOR, self_collision=self_collision, threads=threads)
+    (every core, adapt_threads on); adapt=False runs exactly `threads`; the
+    positions are the same bits for any count."""
+    w, c = scenes.drape(n, DEFAULT_INTEGRATOR, self_collision=self_collision, threads=threads,
+                        adapt_threads=adapt)
     out, wall, fastest = [], 0.0, 0.0
     for _ in range(frames):
         t0 = time.perf_counter()
@@ -143,36 +144,41 @@ def main():
     print()
     cores = os.cpu_count()
     print(f"Ours at World()'s defaults ({DEFAULT_INTEGRATOR} integrator, automatic substeps) on 1 "
-          f"thread, and with the default thread count (every core: {cores} here, "
-          "adapt_threads on); Blender on its own thread pool.")
+          f"thread, with the default thread count (every core: {cores} here, adapt_threads on: "
+          f"the world starts on one and tries more after a few steps), and on exactly {cores} "
+          "threads (adapt_threads off); Blender on its own thread pool.")
     print()
     print("| particles | self-collision | frames | Blender ms/frame | ours ms/frame, 1 thread "
           "| Blender / ours, 1 thread | ours ms/frame, default threads | Blender / ours, default threads "
+          f"| ours ms/frame, {cores} threads | Blender / ours, {cores} threads "
           "| our substeps/frame | our error / size | intersections ours (cloth-cloth, cloth-sphere) "
           "| intersections Blender | lowest point at the end, ours / reference, m "
           "| fastest particle, ours / reference, m/s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for n, frames in cases:
         for self_c in (True, False):
             bw, bk, bfinite = blender_run(n, self_c, frames)
             ow, opos, ok, sub, ofast = ours(n, self_c, frames)
             tw, tpos, _, _, _ = ours(n, self_c, frames, threads=0)
-            if not np.array_equal(tpos, opos):
-                raise SystemExit(f"{n}: positions differ between 1 thread and the default count")
+            fw, fpos, _, _, _ = ours(n, self_c, frames, threads=cores, adapt=False)
+            if not (np.array_equal(tpos, opos) and np.array_equal(fpos, opos)):
+                raise SystemExit(f"{n}: positions differ between thread counts")
             _, rpos, _, _, rfast = ours(n, self_c, frames, 8 * sub, threads=0)
             d = np.linalg.norm(opos - rpos, axis=2)
             err = float(np.sqrt(np.mean(d * d)))
             row = {"particles": n * n, "self": self_c, "frames": frames, "blender_s": bw,
                    "ours_s": ow, "ratio": bw / ow, "ours_default_threads_s": tw,
-                   "ratio_default_threads": bw / tw, "substeps": sub, "error": err,
+                   "ratio_default_threads": bw / tw, "ours_all_cores_s": fw,
+                   "ratio_all_cores": bw / fw, "substeps": sub, "error": err,
                    "ours_intersections": ok, "blender_intersections": bk,
                    "blender_finite": bfinite, "lowest": float(opos[-1, :, 2].min()),
                    "reference_lowest": float(rpos[-1, :, 2].min()), "fastest": ofast,
                    "reference_fastest": rfast}
             rows.append(row)
             print(f"| {n * n} | {'on' if self_c else 'off'} | {frames} | {1e3 * bw:.3g} | "
-                  f"{1e3 * ow:.3g} | {bw / ow:.2f} | {1e3 * tw:.3g} | {bw / tw:.2f} | {sub} | "
+                  f"{1e3 * ow:.3g} | {bw / ow:.2f} | {1e3 * tw:.3g} | {bw / tw:.2f} | "
+                  f"{1e3 * fw:.3g} | {bw / fw:.2f} | {sub} | "
                   f"{err:.2e} | "
                   f"{ok['cloth_cloth']}, {ok['cloth_collider']} | "
                   f"{bk['cloth_cloth']}, {bk['cloth_collider']} | {row['lowest']:.3f} / "

@@ -34,12 +34,13 @@ def uv_sphere(radius=0.3, segments=16, rings=8):
     return np.array(v, float), np.array(t, np.int32)
 
 
-def drape(n, integrator="verlet", wet=False, self_collision=False, threads=1, smooth=False):
+def drape(n, integrator="verlet", wet=False, self_collision=False, threads=1, smooth=False,
+          adapt_threads=True):
     """The thesis drape: n x n grid cloth, 1 m, 0.6 m above the 114-vertex
     UV sphere of radius 0.3 m (Table 3.2's scene); wet = soaked (w = 1).
     smooth: the analytic sphere of the same radius (a convex collider)
     instead of the mesh, the control for the mesh's facets."""
-    w = wetcloth.World(integrator=integrator, threads=threads)
+    w = wetcloth.World(integrator=integrator, threads=threads, adapt_threads=adapt_threads)
     if smooth:
         w.add_sphere((0.0, 0.0, 0.0), 0.3)
     else:
