@@ -6,6 +6,7 @@
 
 #include "alloc.h"
 #include "narrowphase.h"
+#include "parallel.h"
 #include "primitives.h"
 
 /* Margins, as fractions of the contact distance r: never less than LOW
@@ -28,6 +29,8 @@
 #define MARGIN_AHEAD 1.5
 
 
+static void makers_free(wc_candidates *c);
+
 static void lists_free(wc_pair_lists *l)
 {
     wci_free(l->start), wci_free(l->count), wci_free(l->room), wci_free(l->path_at);
@@ -40,7 +43,8 @@ void wci_candidates_destroy(wc_candidates *c)
     wci_free(c->base), wci_free(c->margin), wci_free(c->base_path);
     wci_free(c->local_path), wci_free(c->local_step), wci_free(c->particle_mark);
     lists_free(&c->particles), lists_free(&c->triangles), lists_free(&c->edges);
-    wci_free(c->found), wci_free(c->gathered), wci_free(c->gathered_d0);
+    makers_free(c);
+    wci_free(c->jobs);
     memset(c, 0, sizeof *c);
 }
 
@@ -134,19 +138,6 @@ double wci_candidates_particle_distance(const wc_collider *col, int32_t t, const
     return sqrt(wci_point_triangle_closest(p, a, b, c, w));
 }
 
-/* Collider triangles whose boxes meet `box`, into c->found (grown as
- * needed). -1 on out-of-memory. */
-static int32_t query(wc_candidates *c, const wc_bvh *bvh, const double box[6])
-{
-    int32_t n = wci_bvh_collect(bvh, box, c->found, c->found_capacity);
-    if (n <= c->found_capacity) return n;
-    int32_t *grown = wci_alloc_array((size_t)n, 2 * sizeof *grown);
-    if (!grown) return -1;
-    wci_free(c->found);
-    c->found = grown, c->found_capacity = 2 * n;
-    return wci_bvh_collect(bvh, box, c->found, c->found_capacity);
-}
-
 /* Scratch for one owner's pairs: `n` ids and distances. */
 typedef struct pair_entry {
     double d0;
@@ -195,42 +186,104 @@ static void sort_by_item(pair_entry *e, pair_entry *tmp, int32_t n)
     if (from != e) memcpy(e, from, (size_t)n * sizeof *e);
 }
 
-/* The owner's kept pairs, ascending by item (the order the tests take
- * them in), into lists l. */
-static int keep_sorted(wc_candidates *c, wc_pair_lists *l, int32_t owner, pair_entry *e, int32_t n,
-                       double path, const double *snap)
+/* Making lists. A rebase makes the lists of its particles and of their
+ * triangles and edges, each from the bases and the collider alone, so they
+ * are made on the step's threads, each thread a contiguous run of them
+ * with scratch of its own (a maker), into the maker's pool of pairs; then
+ * they are put into the lists one after the other in the order of the run
+ * (lists_put), which places them in the lists' pool as one thread would:
+ * the same bits for any thread count. */
+
+/* A list to make: what owns it (a particle, a cloth triangle or edge) and,
+ * once made, which maker holds its pairs, where and how many. */
+typedef enum list_kind { LIST_PARTICLE, LIST_TRIANGLE, LIST_EDGE } list_kind;
+
+typedef struct wc_list_job {
+    list_kind kind;
+    int32_t owner;
+    int32_t maker;
+    int32_t count;
+    int64_t at;
+} wc_list_job;
+
+/* One thread's scratch: what a query found, one owner's entries (and the
+ * sort's room), and the pairs of the lists it made. */
+typedef struct wc_list_maker {
+    int32_t *found;
+    int32_t found_capacity;
+    struct pair_entry *entries;
+    int64_t entry_capacity;
+    int32_t *items;
+    double *d0;
+    int64_t used, capacity;
+    int failed;
+} wc_list_maker;
+
+/* Below this many lists a rebase makes them on one thread: waking the
+ * team costs more. */
+#define LISTS_PARALLEL_MIN 64
+
+static void makers_free(wc_candidates *c)
 {
-    /* entries() leaves room for n more after the first n */
-    sort_by_item(e, e + n, n);
-    int32_t *ids = c->gathered;
-    double *d0 = c->gathered_d0;
-    for (int32_t k = 0; k < n; ++k) ids[k] = e[k].item, d0[k] = e[k].d0;
-    return lists_put(l, owner, ids, d0, n, path, snap);
+    for (int32_t t = 0; t < c->maker_count; ++t) {
+        wc_list_maker *m = &c->makers[t];
+        wci_free(m->found), wci_free(m->entries), wci_free(m->items), wci_free(m->d0);
+    }
+    wci_free(c->makers);
+    c->makers = NULL, c->maker_count = 0;
 }
 
-/* Scratch of at least n entries and as many again behind them (the sort's
- * room), and n gathered ids. */
-static pair_entry *entries(wc_candidates *c, int64_t n, pair_entry **buf, int64_t *cap)
+/* The items of bvh whose boxes meet `box`, into m->found (grown as
+ * needed). -1 on out-of-memory. */
+static int32_t query(wc_list_maker *m, const wc_bvh *bvh, const double box[6])
 {
-    if (*buf && 2 * n <= *cap && n <= c->gathered_capacity) return *buf;
-    int64_t want = 2 * n + 64;
-    pair_entry *e = wci_alloc_array(2 * (size_t)want, sizeof *e);
-    int32_t *g = wci_alloc_array((size_t)want, sizeof *g);
-    double *d = wci_alloc_array((size_t)want, sizeof *d);
-    if (!e || !g || !d) {
-        wci_free(e), wci_free(g), wci_free(d);
-        return NULL;
-    }
-    wci_free(*buf), wci_free(c->gathered), wci_free(c->gathered_d0);
-    *buf = e, *cap = 2 * want;
-    c->gathered = g, c->gathered_d0 = d, c->gathered_capacity = want;
+    int32_t n = wci_bvh_collect(bvh, box, m->found, m->found_capacity);
+    if (n <= m->found_capacity) return n;
+    int32_t *grown = wci_alloc_array((size_t)n, 2 * sizeof *grown);
+    if (!grown) return -1;
+    wci_free(m->found);
+    m->found = grown, m->found_capacity = 2 * n;
+    return wci_bvh_collect(bvh, box, m->found, m->found_capacity);
+}
+
+/* Room for n entries and as many again behind them (the sort's). */
+static pair_entry *entries(wc_list_maker *m, int64_t n)
+{
+    if (m->entries && 2 * n <= m->entry_capacity) return m->entries;
+    int64_t want = 2 * (2 * n + 64);
+    pair_entry *e = wci_alloc_array((size_t)want, sizeof *e);
+    if (!e) return NULL;
+    wci_free(m->entries);
+    m->entries = e, m->entry_capacity = want;
     return e;
 }
 
-typedef struct scratch {
-    pair_entry *e;
-    int64_t cap;
-} scratch;
+/* The owner's n kept pairs e, ascending by item (the order the tests take
+ * them in), onto the maker's pool; job records where. 0 on out-of-memory. */
+static int keep_sorted(wc_list_maker *m, wc_list_job *job, pair_entry *e, int32_t n)
+{
+    /* entries() leaves room for n more after the first n */
+    sort_by_item(e, e + n, n);
+    if (m->used + n > m->capacity) {
+        int64_t cap = 2 * (m->used + n) + 1024;
+        int32_t *items = wci_alloc_array((size_t)cap, sizeof *items);
+        double *d0 = wci_alloc_array((size_t)cap, sizeof *d0);
+        if (!items || !d0) {
+            wci_free(items), wci_free(d0);
+            return 0;
+        }
+        if (m->used) {
+            memcpy(items, m->items, (size_t)m->used * sizeof *items);
+            memcpy(d0, m->d0, (size_t)m->used * sizeof *d0);
+        }
+        wci_free(m->items), wci_free(m->d0);
+        m->items = items, m->d0 = d0, m->capacity = cap;
+    }
+    for (int32_t k = 0; k < n; ++k) m->items[m->used + k] = e[k].item, m->d0[m->used + k] = e[k].d0;
+    job->at = m->used, job->count = n;
+    m->used += n;
+    return 1;
+}
 
 static void base_of(const wc_candidates *c, int32_t i, double out[3]) { vertex_of(c->base, i, out); }
 
@@ -255,49 +308,49 @@ static void element_box(const wc_candidates *c, const int32_t *idx, int count, d
     }
 }
 
-/* Particle i's list: collider triangles within r + margin of its base. */
-static int particle_list(wc_candidates *c, scratch *s, const wc_collider *col, int32_t i)
+/* Particle i's pairs: collider triangles within r + margin of its base. */
+static int particle_pairs(const wc_candidates *c, wc_list_maker *m, const wc_collider *col,
+                          wc_list_job *job)
 {
+    int32_t i = job->owner;
     double p[3], reach = c->r + c->margin[i], box[6];
     base_of(c, i, p);
     for (int k = 0; k < 3; ++k) box[k] = p[k] - reach, box[k + 3] = p[k] + reach;
-    int32_t n = query(c, &col->bvh, box);
+    int32_t n = query(m, &col->bvh, box);
     if (n < 0) return 0;
-    pair_entry *e = entries(c, n, &s->e, &s->cap);
+    pair_entry *e = entries(m, n);
     if (!e) return 0;
     int32_t kept = 0;
     for (int32_t k = 0; k < n; ++k) {
-        double d = wci_candidates_particle_distance(col, c->found[k], p);
-        if (d <= reach) e[kept].d0 = d, e[kept].item = c->found[k], ++kept;
+        double d = wci_candidates_particle_distance(col, m->found[k], p);
+        if (d <= reach) e[kept].d0 = d, e[kept].item = m->found[k], ++kept;
     }
-    return keep_sorted(c, &c->particles, i, e, kept, c->base_path[i], p);
+    return keep_sorted(m, job, e, kept);
 }
 
-/* Cloth triangle t's list: collider vertices within the feature distance
+/* Cloth triangle t's pairs: collider vertices within the feature distance
  * plus M of it (its corners at their bases), from the collider's vertex
  * tree. */
-static int triangle_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, const wc_collider *col,
-                         int32_t t, double path)
+static int triangle_pairs(const wc_candidates *c, wc_list_maker *m, const wc_cloth_elements *el,
+                          const wc_collider *col, wc_list_job *job)
 {
-    const int32_t *idx = el->triangles + 3 * (size_t)t;
+    const int32_t *idx = el->triangles + 3 * (size_t)job->owner;
     double reach = c->feature_r + element_margin(c, idx, 3), box[6], a[3], b[3], d[3];
     element_box(c, idx, 3, reach, box);
-    int32_t n = query(c, &col->vertex_bvh, box);
+    int32_t n = query(m, &col->vertex_bvh, box);
     if (n < 0) return 0;
-    pair_entry *e = entries(c, n, &s->e, &s->cap);
+    pair_entry *e = entries(m, n);
     if (!e) return 0;
     base_of(c, idx[0], a), base_of(c, idx[1], b), base_of(c, idx[2], d);
     int32_t kept = 0;
     for (int32_t k = 0; k < n; ++k) {
-        int32_t v = col->used_vertices[c->found[k]];
+        int32_t v = col->used_vertices[m->found[k]];
         double p[3], w[3];
         vertex_of(col->current, v, p);
         double dist = sqrt(wci_point_triangle_closest(p, a, b, d, w));
         if (dist <= reach) e[kept].d0 = dist, e[kept].item = v, ++kept;
     }
-    double snap[9];
-    memcpy(snap, a, sizeof a), memcpy(snap + 3, b, sizeof b), memcpy(snap + 6, d, sizeof d);
-    return keep_sorted(c, &c->triangles, t, e, kept, path, snap);
+    return keep_sorted(m, job, e, kept);
 }
 
 /* A lower bound on the distance between segments p-q and a-b: from the
@@ -322,22 +375,22 @@ static double segment_lower_bound(const double p[3], const double q[3], const do
     return sqrt(d2) - sqrt(half2);
 }
 
-/* Cloth edge e's list: collider edges within the feature distance plus M
+/* Cloth edge e's pairs: collider edges within the feature distance plus M
  * of it, from the collider's edge tree. */
-static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, const wc_collider *col,
-                     int32_t edge, double path)
+static int edge_pairs(const wc_candidates *c, wc_list_maker *m, const wc_cloth_elements *el,
+                      const wc_collider *col, wc_list_job *job)
 {
-    const int32_t *idx = el->edges + 2 * (size_t)edge;
+    const int32_t *idx = el->edges + 2 * (size_t)job->owner;
     double reach = c->feature_r + element_margin(c, idx, 2), box[6], a[3], b[3];
     element_box(c, idx, 2, reach, box);
-    int32_t n = query(c, &col->edge_bvh, box);
+    int32_t n = query(m, &col->edge_bvh, box);
     if (n < 0) return 0;
-    pair_entry *e = entries(c, n, &s->e, &s->cap);
+    pair_entry *e = entries(m, n);
     if (!e) return 0;
     base_of(c, idx[0], a), base_of(c, idx[1], b);
     int32_t kept = 0;
     for (int32_t k = 0; k < n; ++k) {
-        int32_t f = c->found[k];
+        int32_t f = m->found[k];
         double p[3], q[3], u, v;
         vertex_of(col->current, col->edges[2 * (size_t)f], p);
         vertex_of(col->current, col->edges[2 * (size_t)f + 1], q);
@@ -347,9 +400,97 @@ static int edge_list(wc_candidates *c, scratch *s, const wc_cloth_elements *el, 
         double dist = sqrt(wci_segment_segment_closest(p, q, a, b, &u, &v));
         if (dist <= reach) e[kept].d0 = dist, e[kept].item = f, ++kept;
     }
-    double snap[6];
-    memcpy(snap, a, sizeof a), memcpy(snap + 3, b, sizeof b);
-    return keep_sorted(c, &c->edges, edge, e, kept, path, snap);
+    return keep_sorted(m, job, e, kept);
+}
+
+/* What making the lists reads, for the team. */
+typedef struct make_pass {
+    wc_candidates *cand;
+    const wc_cloth_elements *el;
+    const wc_collider *col;
+    int32_t jobs;
+} make_pass;
+
+static void make_body(void *context, const wc_team *team)
+{
+    const make_pass *pass = context;
+    wc_candidates *c = pass->cand;
+    wc_list_maker *m = &c->makers[team->thread];
+    int64_t begin, end;
+    wc_team_slice(team, pass->jobs, team->threads > 1, &begin, &end);
+    m->used = 0, m->failed = 0;
+    for (int64_t j = begin; j < end && !m->failed; ++j) {
+        wc_list_job *job = &c->jobs[j];
+        job->maker = team->thread;
+        int ok = job->kind == LIST_PARTICLE ? particle_pairs(c, m, pass->col, job)
+                 : job->kind == LIST_TRIANGLE ? triangle_pairs(c, m, pass->el, pass->col, job)
+                                              : edge_pairs(c, m, pass->el, pass->col, job);
+        m->failed = !ok;
+    }
+}
+
+/* Owner job->owner's list from its pairs: the snapshot is its particles'
+ * bases and the local path the list counts from (a particle's at its
+ * rebase, an element's at its first particle now). */
+static int put_list(wc_candidates *c, const wc_cloth_elements *el, const wc_list_job *job)
+{
+    const wc_list_maker *m = &c->makers[job->maker];
+    /* a maker whose lists were all empty has no pool */
+    const int32_t *items = job->count ? m->items + job->at : NULL;
+    const double *d0 = job->count ? m->d0 + job->at : NULL;
+    double snap[9];
+    if (job->kind == LIST_PARTICLE) {
+        base_of(c, job->owner, snap);
+        return lists_put(&c->particles, job->owner, items, d0, job->count,
+                         c->base_path[job->owner], snap);
+    }
+    int per = job->kind == LIST_TRIANGLE ? 3 : 2;
+    const int32_t *idx = per == 3 ? el->triangles + 3 * (size_t)job->owner
+                                  : el->edges + 2 * (size_t)job->owner;
+    for (int k = 0; k < per; ++k) base_of(c, idx[k], snap + 3 * k);
+    return lists_put(per == 3 ? &c->triangles : &c->edges, job->owner, items, d0, job->count,
+                     c->local_path[idx[0]], snap);
+}
+
+/* Room for n jobs and a maker per thread. 0 on out-of-memory. */
+static int ready_jobs(wc_candidates *c, int64_t n, int threads)
+{
+    if (n > c->job_capacity) {
+        int64_t want = n + n / 2 + 64;
+        wc_list_job *jobs = wci_alloc_array((size_t)want, sizeof *jobs);
+        if (!jobs) return 0;
+        wci_free(c->jobs);
+        c->jobs = jobs, c->job_capacity = (int32_t)want;
+    }
+    if (threads > c->maker_count) {
+        wc_list_maker *makers = wci_alloc_array((size_t)threads, sizeof *makers);
+        if (!makers) return 0;
+        if (c->maker_count) memcpy(makers, c->makers, (size_t)c->maker_count * sizeof *makers);
+        wci_free(c->makers);
+        c->makers = makers, c->maker_count = threads;
+    }
+    return 1;
+}
+
+/* Makes the lists of c->jobs[0 .. count), then puts them in that order.
+ * 0 on out-of-memory. */
+static int make_lists(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                      int32_t count, int threads)
+{
+    int team = count >= LISTS_PARALLEL_MIN ? threads : 1;
+    make_pass pass = {c, el, col, count};
+    wci_parallel_team(team, make_body, &pass);
+    for (int32_t t = 0; t < team; ++t)
+        if (c->makers[t].failed) return 0;
+    for (int32_t j = 0; j < count; ++j)
+        if (!put_list(c, el, &c->jobs[j])) return 0;
+    return 1;
+}
+
+static void add_job(wc_candidates *c, int32_t *count, list_kind kind, int32_t owner)
+{
+    c->jobs[*count].kind = kind, c->jobs[*count].owner = owner;
+    ++*count;
 }
 
 /* New base (the start of the step) and margin for particle i. Its margin
@@ -394,24 +535,22 @@ static int allocate(wc_candidates *c, const wc_cloth_elements *el)
 }
 
 wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
-                              double r, const wc_particle_arrays *p, int32_t steps_left)
+                              double r, const wc_particle_arrays *p, int32_t steps_left, int threads)
 {
+    int64_t jobs = (int64_t)el->particle_count + el->triangle_count + el->edge_count;
     if (!allocate(c, el) || !lists_init(&c->particles, el->particle_count, 1) ||
-        !lists_init(&c->triangles, el->triangle_count, 3) || !lists_init(&c->edges, el->edge_count, 2))
+        !lists_init(&c->triangles, el->triangle_count, 3) || !lists_init(&c->edges, el->edge_count, 2) ||
+        jobs > INT32_MAX || !ready_jobs(c, jobs, threads))
         return WC_ERROR_OUT_OF_MEMORY;
     c->r = r;
     c->feature_r = WC_FEATURE_DISTANCE * r;
-    scratch s = {NULL, 0};
-    int ok = 1;
     for (int32_t i = 0; i < el->particle_count; ++i) c->local_path[i] = 0.0, c->local_step[i] = 0.0;
     for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, i, p, steps_left);
-    for (int32_t i = 0; i < el->particle_count && ok; ++i) ok = particle_list(c, &s, col, i);
-    for (int32_t t = 0; t < el->triangle_count && ok; ++t)
-        ok = triangle_list(c, &s, el, col, t, c->local_path[el->triangles[3 * (size_t)t]]);
-    for (int32_t e = 0; e < el->edge_count && ok; ++e)
-        ok = edge_list(c, &s, el, col, e, c->local_path[el->edges[2 * (size_t)e]]);
-    wci_free(s.e);
-    if (!ok) {
+    int32_t count = 0;
+    for (int32_t i = 0; i < el->particle_count; ++i) add_job(c, &count, LIST_PARTICLE, i);
+    for (int32_t t = 0; t < el->triangle_count; ++t) add_job(c, &count, LIST_TRIANGLE, t);
+    for (int32_t e = 0; e < el->edge_count; ++e) add_job(c, &count, LIST_EDGE, e);
+    if (!make_lists(c, el, col, count, threads)) {
         c->r = 0.0; /* made again at the next use */
         return WC_ERROR_OUT_OF_MEMORY;
     }
@@ -421,30 +560,37 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
 
 wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
                                const int32_t *particles, int32_t count, const wc_particle_arrays *p,
-                               int32_t steps_left, uint8_t *mark)
+                               int32_t steps_left, uint8_t *mark, int threads)
 {
-    scratch s = {NULL, 0};
-    int ok = 1;
+    /* at most each particle and each of its triangles and edges once */
+    int64_t most = count;
+    for (int32_t k = 0; k < count; ++k) {
+        int32_t i = particles[k];
+        most += el->triangles_start[i + 1] - el->triangles_start[i];
+        most += el->edges_start[i + 1] - el->edges_start[i];
+    }
+    if (most > INT32_MAX || !ready_jobs(c, most, threads)) {
+        c->r = 0.0;
+        return WC_ERROR_OUT_OF_MEMORY;
+    }
     for (int32_t k = 0; k < count; ++k) rebase_one(c, col, particles[k], p, steps_left);
-    for (int32_t k = 0; k < count && ok; ++k) ok = particle_list(c, &s, col, particles[k]);
+    int32_t jobs = 0;
+    for (int32_t k = 0; k < count; ++k) add_job(c, &jobs, LIST_PARTICLE, particles[k]);
     /* each triangle and edge of a rebased particle once, in the order met */
-    for (int kind = 0; kind < 2 && ok; ++kind) {
+    for (int kind = 0; kind < 2; ++kind) {
         const int32_t *start = kind ? el->edges_start : el->triangles_start;
         const int32_t *items = kind ? el->edges_of : el->triangles_of;
-        for (int32_t k = 0; k < count && ok; ++k)
-            for (int32_t j = start[particles[k]]; j < start[particles[k] + 1] && ok; ++j) {
+        for (int32_t k = 0; k < count; ++k)
+            for (int32_t j = start[particles[k]]; j < start[particles[k] + 1]; ++j) {
                 int32_t e = items[j];
                 if (mark[e]) continue;
                 mark[e] = 1;
-                int32_t first = kind ? el->edges[2 * (size_t)e] : el->triangles[3 * (size_t)e];
-                ok = kind ? edge_list(c, &s, el, col, e, c->local_path[first])
-                          : triangle_list(c, &s, el, col, e, c->local_path[first]);
+                add_job(c, &jobs, kind ? LIST_EDGE : LIST_TRIANGLE, e);
             }
         for (int32_t k = 0; k < count; ++k)
             for (int32_t j = start[particles[k]]; j < start[particles[k] + 1]; ++j) mark[items[j]] = 0;
     }
-    wci_free(s.e);
-    if (!ok) {
+    if (!make_lists(c, el, col, jobs, threads)) {
         c->r = 0.0;
         return WC_ERROR_OUT_OF_MEMORY;
     }

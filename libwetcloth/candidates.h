@@ -137,13 +137,12 @@ typedef struct wc_candidates {
     /// largest (its step motion), as if the whole collider were near.
     int whole_collider;
     wc_pair_lists particles, triangles, edges;
-    /// Scratch: the collider items a query found, and one owner's kept ids
-    /// and distances.
-    int32_t *found;
-    int32_t found_capacity;
-    int32_t *gathered;
-    double *gathered_d0;
-    int64_t gathered_capacity;
+    /// The lists being made (candidates.c, making lists): one maker of
+    /// scratch per thread, and per list its owner and where its pairs are.
+    struct wc_list_maker *makers;
+    int32_t maker_count;
+    struct wc_list_job *jobs;
+    int32_t job_capacity;
 } wc_candidates;
 
 /// The cloth's side of the lists: its triangles and edges, and per particle
@@ -217,11 +216,12 @@ double wci_candidates_displacement(const wc_candidates *cand, const wc_particle_
 
 /// Makes every list (first use, or the contact distance changed), with
 /// every particle rebased at its start-of-step position; `steps_left` is
-/// how many steps of the running frame follow this one (margins).
+/// how many steps of the running frame follow this one (margins). The lists
+/// are made on up to `threads` threads, the same bits for any count.
 /// WC_ERROR_OUT_OF_MEMORY on failure.
 wc_status wci_candidates_update(wc_candidates *cand, const wc_cloth_elements *el,
                               const wc_collider *col, double r, const wc_particle_arrays *p,
-                              int32_t steps_left);
+                              int32_t steps_left, int threads);
 
 /// Rebases the `count` particles listed (new base at their start-of-step
 /// position and a new margin) and makes their lists and those of their
@@ -229,7 +229,8 @@ wc_status wci_candidates_update(wc_candidates *cand, const wc_cloth_elements *el
 /// zero), sized for the larger of the cloth's triangle and edge counts.
 wc_status wci_candidates_rebase(wc_candidates *cand, const wc_cloth_elements *el,
                                const wc_collider *col, const int32_t *particles, int32_t count,
-                               const wc_particle_arrays *p, int32_t steps_left, uint8_t *mark);
+                               const wc_particle_arrays *p, int32_t steps_left, uint8_t *mark,
+                               int threads);
 
 /// How far owner k's particles can be from where they were at its
 /// snapshot, over the step (starts and ends).

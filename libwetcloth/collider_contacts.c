@@ -236,12 +236,12 @@ static void note_rebase(wc_collider_contacts *s, int32_t i)
 
 /* Rebases the noted particles against collider k and clears the notes. */
 static wc_status flush_rebase(wc_collider_contacts *s, const wc_collider *col, int32_t k,
-                              const wc_particle_arrays *p, int32_t steps_left)
+                              const wc_particle_arrays *p, int32_t steps_left, int threads)
 {
     wc_status st = WC_OK;
     if (s->rebase_count)
         st = wci_candidates_rebase(&s->cand[k], &s->el, col, s->rebase_list, s->rebase_count, p,
-                                  steps_left, s->visit_mark);
+                                  steps_left, s->visit_mark, threads);
     for (int32_t j = 0; j < s->rebase_count; ++j) s->rebase_flag[s->rebase_list[j]] = 0;
     s->rebase_count = 0;
     return st;
@@ -252,7 +252,7 @@ static wc_status flush_rebase(wc_collider_contacts *s, const wc_collider *col, i
  * motion in this step leaves their cover. */
 static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
                                     wc_collider *const *colliders, int32_t count,
-                                    const wc_particle_arrays *p, int32_t steps_left)
+                                    const wc_particle_arrays *p, int32_t steps_left, int threads)
 {
     if (!grow_candidates(s, count)) return WC_ERROR_OUT_OF_MEMORY;
     for (int32_t k = 0; k < count; ++k) {
@@ -262,7 +262,7 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         cand->whole_collider = s->whole_collider;
         double r = contact_distance(c, col);
         if (cand->r != r) {
-            if (wci_candidates_update(cand, &s->el, col, r, p, steps_left))
+            if (wci_candidates_update(cand, &s->el, col, r, p, steps_left, threads))
                 return WC_ERROR_OUT_OF_MEMORY;
             continue;
         }
@@ -270,7 +270,7 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         for (int32_t i = 0; i < c->particle_count; ++i)
             if (wc_candidates_rebase_due(cand, i, wci_candidates_displacement(cand, p, i)))
                 note_rebase(s, i);
-        if (flush_rebase(s, col, k, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+        if (flush_rebase(s, col, k, p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
     }
     return WC_OK;
 }
@@ -658,7 +658,7 @@ static wc_status note_pushed(wc_collider_contacts *s, const wc_particle_arrays *
             if (moved[j] && !wc_candidates_covers(&s->cand[c], k->particle[j],
                                                   wci_candidates_displacement(&s->cand[c], p, k->particle[j])))
                 note_rebase(s, k->particle[j]);
-        if (flush_rebase(s, col, c, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+        if (flush_rebase(s, col, c, p, steps_left, 1)) return WC_ERROR_OUT_OF_MEMORY;
     }
     return WC_OK;
 }
@@ -893,7 +893,7 @@ static wc_status pass_rounds(wc_collider_contacts *s, wc_cloth *c, const wc_part
                 if (s->shifted[i] &&
                     !wc_candidates_covers(&s->cand[k], i, wci_candidates_displacement(&s->cand[k], p, i)))
                     note_rebase(s, i);
-            if (flush_rebase(s, colliders[k], k, p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+            if (flush_rebase(s, colliders[k], k, p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
         }
         int moved = feature_pass(s, c, p, colliders, count, all && round == 0, steps_left, failsafe);
         if (moved < 0) return WC_ERROR_OUT_OF_MEMORY;
@@ -909,7 +909,7 @@ wc_status wci_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
     if (count <= 0) return WC_OK;
     wc_particle_arrays p = wci_particle_arrays_of(c);
     for (int32_t i = 0; i < c->particle_count; ++i) track(s, &p, i);
-    if (refresh_candidates(s, c, colliders, count, &p, steps_left)) return WC_ERROR_OUT_OF_MEMORY;
+    if (refresh_candidates(s, c, colliders, count, &p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
     int32_t failsafe = 0;
     wc_status status = pass_rounds(s, c, &p, colliders, count, steps_left, threads, 1, NULL, &failsafe);
     stats->failsafe_particles += failsafe;

@@ -23,7 +23,8 @@
  *
  * Keys: frames (24), integrator (default | verlet | xpbd | implicit),
  * steps (substeps per frame, 0 = automatic; ignored with the default
- * integrator unless given), threads (1), wet (0 | 1: wetness 1), self (0 |
+ * integrator unless given), threads (1), adapt (1: the world's adapt_threads,
+ * the library's default; 0 runs exactly `threads`), wet (0 | 1: wetness 1), self (0 |
  * 1: self-collision), thickness (collider thickness, m, 0.02: Blender's
  * Collision modifier default, which the add-on passes on), friction (the
  * collider's, 0.5), size (override the cloth's particle count per side),
@@ -56,7 +57,7 @@
 
 typedef struct options {
     const char *scene;
-    int frames, steps, threads, wet, self, size, check, steps_given, bend, trace;
+    int frames, steps, threads, adapt, wet, self, size, check, steps_given, bend, trace;
     const char *integrator;
     double thickness, friction, adhesion, spread, wet_friction, damping;
     const char *out;
@@ -163,7 +164,7 @@ static int32_t add_mesh(wc_world *w, const mesh *m, const options *o)
 static int parse(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
-    o->scene = "thesis", o->frames = 24, o->threads = 1, o->thickness = 0.02, o->friction = 0.5;
+    o->scene = "thesis", o->frames = 24, o->threads = 1, o->adapt = 1, o->thickness = 0.02, o->friction = 0.5;
     o->integrator = "default", o->check = 1, o->bend = 1, o->adhesion = -1.0, o->spread = -1.0, o->wet_friction = -1.0, o->damping = -1.0;
     for (int k = 1; k < argc; ++k) {
         char *eq = strchr(argv[k], '=');
@@ -174,6 +175,7 @@ static int parse(int argc, char **argv, options *o)
         else if (!strcmp(key, "frames")) o->frames = atoi(val);
         else if (!strcmp(key, "steps")) o->steps = atoi(val), o->steps_given = 1;
         else if (!strcmp(key, "threads")) o->threads = atoi(val);
+        else if (!strcmp(key, "adapt")) o->adapt = atoi(val);
         else if (!strcmp(key, "wet")) o->wet = atoi(val);
         else if (!strcmp(key, "self")) o->self = atoi(val);
         else if (!strcmp(key, "size")) o->size = atoi(val);
@@ -217,6 +219,7 @@ static scene make_scene(const options *o)
     memset(&s, 0, sizeof s);
     wc_world_def wd = wc_world_def_default();
     wd.thread_count = o->threads;
+    wd.adapt_threads = o->adapt;
     if (!set_integrator(&wd, o->integrator)) {
         fprintf(stderr, "unknown integrator %s\n", o->integrator);
         exit(2);
@@ -276,7 +279,7 @@ int main(int argc, char **argv)
     if (!parse(argc, argv, &o)) {
         fprintf(stderr, "usage: bench_contacts scene=thesis|sphere64|sphere176|soaked|cylinder|"
                         "drape101 [frames=24] [integrator=default|verlet|xpbd|implicit] [steps=0] "
-                        "[threads=1] [wet=0] [self=0] [thickness=0.02] [friction=0.5] [size=N] "
+                        "[threads=1] [adapt=1] [wet=0] [self=0] [thickness=0.02] [friction=0.5] [size=N] "
                         "[check=1] [bend=1] [trace=0] [out=FILE]\n");
         return 2;
     }
