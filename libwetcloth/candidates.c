@@ -222,6 +222,10 @@ typedef struct wc_list_maker {
 /* Below this many lists a rebase makes them on one thread: waking the
  * team costs more. */
 #define LISTS_PARALLEL_MIN 64
+/* Lists are made and put this many at a time, so that the makers' pools
+ * hold a batch's pairs, not those of every list at once (the first making
+ * on a dense collider lists millions of pairs). */
+#define LISTS_BATCH 4096
 
 static void makers_free(wc_candidates *c)
 {
@@ -408,7 +412,8 @@ typedef struct make_pass {
     wc_candidates *cand;
     const wc_cloth_elements *el;
     const wc_collider *col;
-    int32_t jobs;
+    /* the batch: jobs [first, first + count) */
+    int32_t first, count;
 } make_pass;
 
 static void make_body(void *context, const wc_team *team)
@@ -417,10 +422,10 @@ static void make_body(void *context, const wc_team *team)
     wc_candidates *c = pass->cand;
     wc_list_maker *m = &c->makers[team->thread];
     int64_t begin, end;
-    wc_team_slice(team, pass->jobs, team->threads > 1, &begin, &end);
-    m->used = 0, m->failed = 0;
+    wc_team_slice(team, pass->count, team->threads > 1, &begin, &end);
+    m->used = 0;
     for (int64_t j = begin; j < end && !m->failed; ++j) {
-        wc_list_job *job = &c->jobs[j];
+        wc_list_job *job = &c->jobs[pass->first + j];
         job->maker = team->thread;
         int ok = job->kind == LIST_PARTICLE ? particle_pairs(c, m, pass->col, job)
                  : job->kind == LIST_TRIANGLE ? triangle_pairs(c, m, pass->el, pass->col, job)
@@ -457,6 +462,7 @@ static int ready_jobs(wc_candidates *c, int64_t n, int threads)
 {
     if (n > c->job_capacity) {
         int64_t want = n + n / 2 + 64;
+        if (want > INT32_MAX) want = n;
         wc_list_job *jobs = wci_alloc_array((size_t)want, sizeof *jobs);
         if (!jobs) return 0;
         wci_free(c->jobs);
@@ -478,12 +484,16 @@ static int make_lists(wc_candidates *c, const wc_cloth_elements *el, const wc_co
                       int32_t count, int threads)
 {
     int team = count >= LISTS_PARALLEL_MIN ? threads : 1;
-    make_pass pass = {c, el, col, count};
-    wci_parallel_team(team, make_body, &pass);
-    for (int32_t t = 0; t < team; ++t)
-        if (c->makers[t].failed) return 0;
-    for (int32_t j = 0; j < count; ++j)
-        if (!put_list(c, el, &c->jobs[j])) return 0;
+    for (int32_t first = 0; first < count; first += LISTS_BATCH) {
+        make_pass pass = {c, el, col, first, count - first < LISTS_BATCH ? count - first : LISTS_BATCH};
+        /* every maker, not only those the runtime gives the team */
+        for (int32_t t = 0; t < c->maker_count; ++t) c->makers[t].failed = 0;
+        wci_parallel_team(team, make_body, &pass);
+        for (int32_t t = 0; t < c->maker_count; ++t)
+            if (c->makers[t].failed) return 0;
+        for (int32_t j = first; j < first + pass.count; ++j)
+            if (!put_list(c, el, &c->jobs[j])) return 0;
+    }
     return 1;
 }
 
