@@ -414,12 +414,14 @@ static uint64_t sphere_drop_hash(int32_t threads)
 
 /* The same with the default integrator (the implicit one) and a denser
  * sphere of Blender's collider thickness, 0.02 m: the candidates' lists,
- * their rebases and the parallel particle pass with many pairs per
- * particle. */
+ * made on the world's threads in several batches (about 24,000 of them at
+ * the first step), their rebases and the parallel particle pass with many
+ * pairs per particle. */
 static uint64_t thick_drop_hash(int32_t threads)
 {
     wc_world_def def = wc_world_def_default();
     def.thread_count = threads;
+    def.adapt_threads = 0; /* exactly `threads`, from the first step: the lists made in parallel */
     wc_world *w = scene_world_from(&def);
     static double v[3 * (2 + 31 * 64)];
     static int32_t t[3 * 2 * 64 * 31];
