@@ -16,8 +16,8 @@ BUNDLED = os.path.join(os.path.dirname(os.path.abspath(__file__)), "presets", SU
 # What a preset holds: the material, as Blender's cloth presets hold its
 # physical properties (not the pins, groups, colliders or cache).
 VALUES = ("density", "air_drag", "stretch", "bend", "damping", "thickness", "friction",
-          "adhesion", "spread", "wet_friction", "wet_mass_gain", "wet_softening", "wicking",
-          "drying")
+          "adhesion", "spread", "wet_friction", "wet_grip", "wet_mass_gain", "wet_softening",
+          "wicking", "drying")
 
 
 def preset_folders():

@@ -31,6 +31,7 @@ MATERIAL_RANGES = {
     "adhesion": (0.0, 1e6, False),
     "spread": (0.0, 1.0, False),
     "wet_friction": (0.0, 1.0, False),
+    "wet_grip": (0.0, 1e6, False),
     "wet_mass_gain": (0.0, 10.0, False),
     "wet_softening": (0.0, 0.99, False),
     "wicking": (0.0, 1.0, False),
@@ -168,6 +169,8 @@ class WetClothSettings(bpy.types.PropertyGroup):
     wet_friction: _float("Wet Friction", "Share of the sliding speed that wet cloth keeps where "
                          "it stays stuck (lower holds it more firmly)", 0.05, 0.0, 1.0,
                          subtype="FACTOR")
+    wet_grip: _float("Wet Grip", "Most tangential stress wet friction holds, in Pa: past it "
+                     "wet cloth slides (0: no wet friction)", 60.0, 0.0, 1000.0, 2, 100)
     wet_mass_gain: _float("Water Uptake", "Mass of the water in soaked cloth, as a multiple of "
                           "the dry mass", 1.0, 0.0, 3.0)
     wet_softening: _float("Wet Softening", "Share of its stiffness that soaked cloth loses",

@@ -132,6 +132,7 @@ class PHYSICS_PT_wet_cloth_wetness(_WetClothSubPanel, bpy.types.Panel):
         col.prop(s, "adhesion")
         col.prop(s, "spread")
         col.prop(s, "wet_friction")
+        col.prop(s, "wet_grip")
         col.prop(s, "wet_mass_gain")
         col.prop(s, "wet_softening")
         col.prop(s, "wicking")

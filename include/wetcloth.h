@@ -277,6 +277,15 @@ typedef struct wc_material {
     /// 1 - w (1 - q) on top of Coulomb friction (thesis eq. 2.10); 1 = no
     /// extra friction. Default 0.05.
     double wet_friction;
+    /// Wet grip of soaked cloth (w = 1), Pa, [0, 1e6]: the most tangential
+    /// stress wet friction holds. It takes off at most g w A / m of a
+    /// particle's tangential acceleration (g this grip, A the particle's area,
+    /// m its wet mass), however hard its links pull; beyond that wet cloth
+    /// slides. 0 turns wet friction off; a large value keeps the thesis' law
+    /// whatever the pull (wet cloth on a moving collider then stretches
+    /// without bound: docs/wetness.md). Default 60 (twice the default
+    /// adhesion: 200 m/s^2 on soaked default cloth, about 20 g).
+    double wet_grip;
     /// Water uptake at w = 1 as a fraction of dry mass, [0, 10]: mass is
     /// multiplied by 1 + wet_mass_gain * w. Default 1.0 (100 %; cotton takes
     /// up 50-200 %).

@@ -73,7 +73,7 @@ static int alloc_particle_arrays(wc_cloth *c)
     c->contact_prev = wci_alloc_array(n, sizeof *c->contact_prev);
     c->stuck = wci_alloc_array(n, sizeof *c->stuck);
     c->history_override = wci_alloc_array(n, sizeof *c->history_override);
-    ok &= alloc_doubles(&c->wetness, n);
+    ok &= alloc_doubles(&c->wetness, n) & alloc_doubles(&c->grip, n);
     if (c->material.wicking > 0.0) ok &= alloc_doubles(&c->wetness_next, n);
     return ok && c->link_start && c->link_list && c->pin_slot && c->contact && c->contact_prev &&
            c->stuck && c->history_override;
@@ -225,6 +225,7 @@ void wci_cloth_apply_material(wc_cloth *c)
     for (int32_t i = 0; i < c->particle_count; ++i) {
         c->mass[i] = m->density * t->area[i] * (1.0 + m->wet_mass_gain * w[i]);
         c->inv_mass[i] = 1.0 / c->mass[i];
+        c->grip[i] = m->wet_grip * t->area[i] * w[i] * c->inv_mass[i];
     }
     for (int32_t e = 0; e < t->stretch.count; ++e) {
         int32_t a = t->stretch.a[e], b = t->stretch.b[e];

@@ -57,6 +57,9 @@ typedef struct wc_cloth {
     int has_history;
     /// Length of the last step, s.
     double dt_prev;
+    /// Length of the step being computed, s: set before its collisions, for
+    /// the bound on wet friction (response.h).
+    double dt_step;
 
     wc_material material;
     wc_topology topology;
@@ -128,6 +131,10 @@ typedef struct wc_cloth {
     /* Wetness. */
     /// Wetness of each particle, [0, 1].
     double *wetness;
+    /// Wet grip of each particle, m/s^2: wet_grip * area * w / m, the most
+    /// tangential acceleration wet friction takes off it (response.h). Kept
+    /// by wci_cloth_apply_material.
+    double *grip;
     /// Contact kind of each particle in the step before the last one.
     uint8_t *contact_prev;
     /// Stuck: wet and in contact in the last two steps.

@@ -299,6 +299,7 @@ wc_status wci_cloth_group_collide(wc_cloth_group *g, wc_cloth *const *cloths, do
 {
     wc_cloth *comb = &g->combined;
     memset(g->handled, 0, (size_t)g->world_cloths);
+    comb->dt_step = dt;
     comb->material.thickness = 0.0;
     comb->wet_forces = 0;
     for (int32_t k = 0; k < g->count; ++k) {

@@ -19,6 +19,7 @@ wc_material wc_material_default(void)
     m.adhesion = 30.0;
     m.spread = 0.5;
     m.wet_friction = 0.05;
+    m.wet_grip = 60.0;
     m.wet_mass_gain = 1.0;
     m.wet_softening = 0.3;
     m.wicking = 0.0;
@@ -56,6 +57,7 @@ wc_status wci_material_validate(const wc_material *m, wc_message *msg)
     if ((s = check_range(msg, "adhesion", m->adhesion, 0.0, 1e6, 0))) return s;
     if ((s = check_range(msg, "spread", m->spread, 0.0, 1.0, 0))) return s;
     if ((s = check_range(msg, "wet_friction", m->wet_friction, 0.0, 1.0, 0))) return s;
+    if ((s = check_range(msg, "wet_grip", m->wet_grip, 0.0, 1e6, 0))) return s;
     if ((s = check_range(msg, "wet_mass_gain", m->wet_mass_gain, 0.0, 10.0, 0))) return s;
     if ((s = check_range(msg, "wet_softening", m->wet_softening, 0.0, 0.99, 0))) return s;
     if ((s = check_range(msg, "wicking", m->wicking, 0.0, 1.0, 0))) return s;

@@ -5,7 +5,7 @@
 
 #include "alloc.h"
 
-enum { DOUBLES = 21, INTS = 1, BYTES = 4 };
+enum { DOUBLES = 22, INTS = 1, BYTES = 4 };
 
 /* The per-particle arrays, the same order in a cloth and in the world. */
 typedef struct fields {
@@ -18,7 +18,7 @@ static fields cloth_fields(wc_cloth *c)
 {
     fields f = {{&c->x, &c->y, &c->z, &c->px, &c->py, &c->pz, &c->nx, &c->ny, &c->nz, &c->fx,
                  &c->fy, &c->fz, &c->mass, &c->inv_mass, &c->normal_x, &c->normal_y,
-                 &c->normal_z, &c->qx, &c->qy, &c->qz, &c->wetness},
+                 &c->normal_z, &c->qx, &c->qy, &c->qz, &c->wetness, &c->grip},
                 {&c->pin_slot},
                 {&c->contact, &c->contact_prev, &c->stuck, &c->history_override}};
     return f;
@@ -28,7 +28,7 @@ static fields world_fields(wc_particles *p)
 {
     fields f = {{&p->x, &p->y, &p->z, &p->px, &p->py, &p->pz, &p->nx, &p->ny, &p->nz, &p->fx,
                  &p->fy, &p->fz, &p->mass, &p->inv_mass, &p->normal_x, &p->normal_y,
-                 &p->normal_z, &p->qx, &p->qy, &p->qz, &p->wetness},
+                 &p->normal_z, &p->qx, &p->qy, &p->qz, &p->wetness, &p->grip},
                 {&p->pin_slot},
                 {&p->contact, &p->contact_prev, &p->stuck, &p->history_override}};
     return f;

@@ -27,7 +27,7 @@ typedef struct wc_particles {
     /// The one allocation every array below points into.
     void *block;
     double *x, *y, *z, *px, *py, *pz, *nx, *ny, *nz, *fx, *fy, *fz;
-    double *mass, *inv_mass, *normal_x, *normal_y, *normal_z, *qx, *qy, *qz, *wetness;
+    double *mass, *inv_mass, *normal_x, *normal_y, *normal_z, *qx, *qy, *qz, *wetness, *grip;
     int32_t *pin_slot;
     uint8_t *contact, *contact_prev, *stuck, *history_override;
 } wc_particles;

@@ -17,17 +17,25 @@ wc_particle_arrays wci_particle_arrays_of(wc_cloth *c)
     p.normal_x = c->normal_x, p.normal_y = c->normal_y, p.normal_z = c->normal_z;
     p.contact_prev = c->contact_prev;
     p.wetness = c->wetness;
+    p.grip = c->grip;
+    p.step_squared = c->dt_step * c->dt_step;
     return p;
 }
 
-double wci_friction_keep(double mu, double normal_change, double tangential, double wet, double q)
+double wci_friction_keep(double mu, double normal_change, double tangential, double wet, double q,
+                         double grip)
 {
-    double keep = 1.0;
-    if (tangential > 0.0) {
-        keep = 1.0 - mu * normal_change / tangential;
+    if (!(tangential > 0.0)) return 1.0;
+    double keep = 1.0 - mu * normal_change / tangential;
+    if (keep < 0.0) keep = 0.0;
+    if (wet > 0.0) {
+        /* what Coulomb left, less the wet share of it, but never more than
+         * the grip: past that the cloth slides */
+        double wet_loss = wet * (1.0 - q) * keep * tangential;
+        if (wet_loss > grip) wet_loss = grip;
+        keep -= wet_loss / tangential;
         if (keep < 0.0) keep = 0.0;
     }
-    if (wet > 0.0) keep *= 1.0 - wet * (1.0 - q);
     return keep;
 }
 
@@ -44,17 +52,21 @@ static void from_of(const wc_particle_arrays *p, int32_t i, double out[3])
     else out[0] = p->x[i], out[1] = p->y[i], out[2] = p->z[i];
 }
 
-/* The contact's wetness in sustained contact: the weighted wetness of its
- * particles that touched something in the last step, over both sides. */
-static double sustained_wetness(const wc_particle_arrays *p, const wc_contact *k)
+/* The contact's wetness in sustained contact, the weighted wetness of its
+ * particles that touched something in the last step, over both sides; and
+ * *grip, the most tangential displacement wet friction can take off its
+ * point in the step: the same weighted mean of the particles' grip (an
+ * acceleration) times the step squared. */
+static double sustained_wetness(const wc_particle_arrays *p, const wc_contact *k, double *grip)
 {
-    double wet = 0.0, total = 0.0;
+    double wet = 0.0, held = 0.0, total = 0.0;
     for (int j = 0; j < k->count; ++j) {
         int32_t i = k->particle[j];
         double w = fabs(k->weight[j]);
         total += w;
-        if (p->contact_prev[i] != WC_CONTACT_NONE) wet += w * p->wetness[i];
+        if (p->contact_prev[i] != WC_CONTACT_NONE) wet += w * p->wetness[i], held += w * p->grip[i];
     }
+    *grip = total > 0.0 ? held / total * p->step_squared : 0.0;
     return total > 0.0 && wet > 0.0 ? wet / total : 0.0;
 }
 
@@ -134,8 +146,9 @@ int wci_response_apply(const wc_particle_arrays *p, const wc_contact *k,
     }
     double lose = 0.0;
     if (dv > 0.0) {
-        double wet = sustained_wetness(p, k);
-        lose = 1.0 - wci_friction_keep(k->friction, dv, sqrt(dot3(ut, ut)), wet, k->wet_friction);
+        double grip, wet = sustained_wetness(p, k, &grip);
+        lose = 1.0 - wci_friction_keep(k->friction, dv, sqrt(dot3(ut, ut)), wet, k->wet_friction,
+                                       grip);
     }
     /* the point's change of position (de) and of displacement (du) */
     double de[3], du[3];

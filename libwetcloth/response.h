@@ -63,9 +63,11 @@ typedef struct wc_particle_arrays {
     /// contact (toward the particle).
     uint8_t *contact;
     double *normal_x, *normal_y, *normal_z;
-    /// What the last step's contacts were, and the wetness: wet friction.
+    /// What the last step's contacts were, the wetness and the wet grip
+    /// (cloth.h), and the step's length squared, s^2: wet friction.
     const uint8_t *contact_prev;
-    const double *wetness;
+    const double *wetness, *grip;
+    double step_squared;
 } wc_particle_arrays;
 
 /// The arrays of one cloth.
@@ -126,7 +128,9 @@ int wci_response_apply(const wc_particle_arrays *p, const wc_contact *contact,
 
 /// The share of the tangential relative motion a contact keeps: Coulomb's
 /// 1 - mu * normal_change / tangential (at least 0), then, with wet > 0,
-/// times 1 - wet * (1 - q). The friction law, in one place.
-double wci_friction_keep(double mu, double normal_change, double tangential, double wet, double q);
+/// less the wet share wet * (1 - q) of that, but less by at most `grip`
+/// (m) of the motion. The friction law, in one place.
+double wci_friction_keep(double mu, double normal_change, double tangential, double wet, double q,
+                         double grip);
 
 #endif

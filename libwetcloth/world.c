@@ -256,6 +256,7 @@ static wc_status collide(wc_world *w, const step_context *ctx)
         memcpy(cl->contact_prev, cl->contact, (size_t)cl->particle_count);
         memset(cl->contact, 0, (size_t)cl->particle_count);
         memset(cl->history_override, 0, (size_t)cl->particle_count);
+        cl->dt_step = dt;
         if (!w->collider_count) continue;
         if (!cl->collider_contacts && !(cl->collider_contacts = wci_collider_contacts_create(cl)))
             return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY,

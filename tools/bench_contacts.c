@@ -29,7 +29,7 @@
  * Collision modifier default, which the add-on passes on), friction (the
  * collider's, 0.5), size (override the cloth's particle count per side),
  * out (file: float64 positions of every frame, for error measurement),
- * adhesion, spread, wet_friction, damping (stretch damping; the cloth
+ * adhesion, spread, wet_friction, wet_grip, damping (stretch damping; the cloth
  * material's, for experiments),
  * check (1: count intersections at the last frame; 2: at every frame),
  * bend (1: the cylinder's ends rise; 0: it stays straight), trace (1: one
@@ -59,7 +59,7 @@ typedef struct options {
     const char *scene;
     int frames, steps, threads, adapt, wet, self, size, check, steps_given, bend, trace;
     const char *integrator;
-    double thickness, friction, adhesion, spread, wet_friction, damping;
+    double thickness, friction, adhesion, spread, wet_friction, wet_grip, damping;
     const char *out;
 } options;
 
@@ -165,7 +165,7 @@ static int parse(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->scene = "thesis", o->frames = 24, o->threads = 1, o->adapt = 1, o->thickness = 0.02, o->friction = 0.5;
-    o->integrator = "default", o->check = 1, o->bend = 1, o->adhesion = -1.0, o->spread = -1.0, o->wet_friction = -1.0, o->damping = -1.0;
+    o->integrator = "default", o->check = 1, o->bend = 1, o->adhesion = -1.0, o->spread = -1.0, o->wet_friction = -1.0, o->wet_grip = -1.0, o->damping = -1.0;
     for (int k = 1; k < argc; ++k) {
         char *eq = strchr(argv[k], '=');
         if (!eq) return 0;
@@ -189,6 +189,7 @@ static int parse(int argc, char **argv, options *o)
         else if (!strcmp(key, "adhesion")) o->adhesion = atof(val);
         else if (!strcmp(key, "spread")) o->spread = atof(val);
         else if (!strcmp(key, "wet_friction")) o->wet_friction = atof(val);
+        else if (!strcmp(key, "wet_grip")) o->wet_grip = atof(val);
         else if (!strcmp(key, "damping")) o->damping = atof(val);
         else return 0;
     }
@@ -254,6 +255,7 @@ static scene make_scene(const options *o)
     if (o->adhesion >= 0.0) g.material.adhesion = o->adhesion;
     if (o->spread >= 0.0) g.material.spread = o->spread;
     if (o->wet_friction >= 0.0) g.material.wet_friction = o->wet_friction;
+    if (o->wet_grip >= 0.0) g.material.wet_grip = o->wet_grip;
     if (o->damping >= 0.0) g.material.stretch_damping = o->damping;
     bench_check(wc_world_add_grid_cloth(s.world, &g, &s.cloth), s.world, "add cloth");
     s.start_height = height;

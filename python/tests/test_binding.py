@@ -115,9 +115,9 @@ def test_material_defaults_are_the_libraries():
     assert (m.density, m.stretch, m.bend, m.damping, m.air_drag, m.thickness, m.friction) == (
         c.density, c.stretch_stiffness, c.bend_stiffness, c.stretch_damping, c.air_drag,
         c.thickness, c.friction)
-    assert (m.adhesion, m.spread, m.wet_friction, m.wet_mass_gain, m.wet_softening, m.wicking,
-            m.drying) == (c.adhesion, c.spread, c.wet_friction, c.wet_mass_gain,
-                          c.wet_softening, c.wicking, c.drying)
+    assert (m.adhesion, m.spread, m.wet_friction, m.wet_grip, m.wet_mass_gain, m.wet_softening,
+            m.wicking, m.drying) == (c.adhesion, c.spread, c.wet_friction, c.wet_grip,
+                                     c.wet_mass_gain, c.wet_softening, c.wicking, c.drying)
 
 
 def test_material_reaches_the_library():

@@ -127,6 +127,7 @@ _MATERIAL_FIELDS = {
     "adhesion": "adhesion",
     "spread": "spread",
     "wet_friction": "wet_friction",
+    "wet_grip": "wet_grip",
     "wet_mass_gain": "wet_mass_gain",
     "wet_softening": "wet_softening",
     "wicking": "wicking",
@@ -153,6 +154,8 @@ def _make_material_class():
     adhesion       Pa, adhesion pressure of soaked cloth (w = 1) [0, 1e6]
     spread         spread factor beta, pull on neighbours of stuck particles [0, 1]
     wet_friction   q, tangential velocity kept in sustained wet contact [0, 1]
+    wet_grip       Pa, most tangential stress wet friction holds before wet
+                   cloth slides (0 = no wet friction) [0, 1e6]
     wet_mass_gain  water uptake at w = 1 as a fraction of dry mass [0, 10]
     wet_softening  stiffness loss at w = 1 [0, 0.99]
     wicking        m^2/s, diffusion of wetness along links (0 = off) [0, 1]

@@ -257,6 +257,7 @@ static wc_material material(reader *r)
     if (more & 8) m.wet_softening = num(r, m.wet_softening);
     if (more & 16) m.wicking = num(r, 0.01);
     if (more & 32) m.drying = num(r, 0.5);
+    if (more & 64) m.wet_grip = num(r, m.wet_grip);
     return m;
 }
 

@@ -11,6 +11,7 @@ s.friction = 0.5
 s.adhesion = 30.0
 s.spread = 0.5
 s.wet_friction = 0.05
+s.wet_grip = 60.0
 s.wet_mass_gain = 1.0
 s.wet_softening = 0.3
 s.wicking = 0.0

@@ -11,6 +11,7 @@ s.friction = 0.6
 s.adhesion = 20.0
 s.spread = 0.3
 s.wet_friction = 0.1
+s.wet_grip = 40.0
 s.wet_mass_gain = 0.7
 s.wet_softening = 0.2
 s.wicking = 0.0

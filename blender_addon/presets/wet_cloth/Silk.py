@@ -11,6 +11,7 @@ s.friction = 0.3
 s.adhesion = 40.0
 s.spread = 0.6
 s.wet_friction = 0.03
+s.wet_grip = 80.0
 s.wet_mass_gain = 0.8
 s.wet_softening = 0.4
 s.wicking = 0.0

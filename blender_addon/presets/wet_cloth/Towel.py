@@ -11,6 +11,7 @@ s.friction = 0.8
 s.adhesion = 35.0
 s.spread = 0.4
 s.wet_friction = 0.05
+s.wet_grip = 70.0
 s.wet_mass_gain = 2.0
 s.wet_softening = 0.4
 s.wicking = 0.0
