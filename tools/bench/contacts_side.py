@@ -12,10 +12,12 @@ A scene name takes flags after "+": wet (soaked), self (self-collision),
 xpbd12 (both builds with XPBD at 12 steps per frame instead of each one's
 default).
 
-Ours: build/tools/bench_contacts, once with this build's library and once
-with --base's (LD_LIBRARY_PATH; the program uses the public API only, so
-the default integrator and steps are each library's own), alternated --reps
-times; figures are given as ranges over the repetitions. Collider
+Ours: build/tools/bench_contacts with this build's library, and the base
+build's own tools/bench_contacts with its library (built from that commit,
+so that the structs it passes have that library's layout; a base build
+without the program runs this one against its library, through
+LD_LIBRARY_PATH), each at its library's default integrator and steps,
+alternated --reps times; figures are given as ranges over the repetitions. Collider
 thickness 0.02 m (Blender's Collision modifier default, which the add-on
 passes on), friction 0.5, 1 thread.
 
@@ -149,6 +151,17 @@ def base_library_dir(program, base):
     return folder
 
 
+def base_runner(program, base):
+    """The program and library folder for the base build: its own
+    bench_contacts where it has one (built against its own header, so that
+    the structs it passes have that library's layout: wc_material has grown
+    since), else this build's program with the base's library."""
+    own = os.path.join(base, "tools", "bench_contacts")
+    if os.path.isfile(own):
+        return own, os.path.abspath(base)
+    return program, base_library_dir(program, base)
+
+
 def read_positions(path, n):
     a = np.fromfile(path, dtype=np.float64)
     return a.reshape(-1, n, 3)
@@ -262,7 +275,7 @@ def main():
     a = ap.parse_args()
     program = os.path.join(a.build, "tools", "bench_contacts")
     build_lib = os.path.abspath(a.build)
-    base_lib = base_library_dir(program, a.base) if a.base else None
+    base_program, base_lib = base_runner(program, a.base) if a.base else (None, None)
     sweep = [int(q) for q in a.sweep.split(",") if q]
     tmp = tempfile.mkdtemp(prefix="wc-contacts-")
     print(f"load average before: {' '.join(open('/proc/loadavg').read().split()[:3])}")
@@ -281,7 +294,7 @@ def main():
         for rep in range(a.reps):
             if base_lib:
                 bf = a.base_frames or a.frames
-                base_runs.append(ours(program, base_lib, scene, bf, extra))
+                base_runs.append(ours(base_program, base_lib, scene, bf, extra))
             new_runs.append(ours(program, build_lib, scene, a.frames, extra,
                                  out=os.path.join(tmp, "new.bin") if rep == 0 else None))
         err = None
