@@ -15,8 +15,12 @@
  *    the normal change (thesis: dry contact);
  *  * wet friction (thesis eq. 2.10): in sustained contact (the contact's
  *    particles touched something in the last step too) what Coulomb leaves is
- *    scaled by 1 - w (1 - q), w the contact's wetness there; dry contacts take
- *    exactly the Coulomb path, so dry cloth keeps the plain model's bits;
+ *    scaled by 1 - w (1 - q), w the contact's wetness there, but less by at
+ *    most the wet grip's g h^2 (g the particles' grip, an acceleration: the
+ *    most tangential force wet friction holds is wet_grip * A * w, so that
+ *    a cloth pulled harder slides instead of stretching, whatever the step);
+ *    dry contacts take exactly the Coulomb path, so dry cloth keeps the plain
+ *    model's bits;
  *  * the changes are shared among the particles by w_k / m_k (Bridson,
  *    Fedkiw & Anderson 2002, eq. 4): the contact point then moves by exactly
  *    what is asked; a collider has infinite mass.
