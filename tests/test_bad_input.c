@@ -207,7 +207,8 @@ static void test_material(void)
         {"stretch_stiffness", NAN}, {"stretch_stiffness", 2e9}, {"bend_stiffness", -1e-6},
         {"bend_stiffness", NAN},   {"bend_stiffness", 1e4},    {"stretch_damping", -0.1},
         {"stretch_damping", 1.5},  {"stretch_damping", NAN},   {"air_drag", -1.0},
-        {"air_drag", NAN},         {"air_drag", 1e5},
+        {"air_drag", NAN},         {"air_drag", 1e5},          {"wet_grip", -1.0},
+        {"wet_grip", NAN},         {"wet_grip", 2e6},
     };
     int32_t id = -1;
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
@@ -219,6 +220,7 @@ static void test_material(void)
         if (!strcmp(cases[i].field, "bend_stiffness")) mat->bend_stiffness = cases[i].value;
         if (!strcmp(cases[i].field, "stretch_damping")) mat->stretch_damping = cases[i].value;
         if (!strcmp(cases[i].field, "air_drag")) mat->air_drag = cases[i].value;
+        if (!strcmp(cases[i].field, "wet_grip")) mat->wet_grip = cases[i].value;
         char call[80];
         snprintf(call, sizeof call, "material.%s = %g", cases[i].field, cases[i].value);
         expect(wc_world_add_grid_cloth(wa, &g, &id), WC_ERROR_INVALID_ARGUMENT, call, cases[i].field, NULL);
