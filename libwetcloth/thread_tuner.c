@@ -38,6 +38,21 @@
  * 4-step probe took 65-80 ms against 5.5-6, one that ends it after its
  * first step 46-49). */
 #define ABANDON 2.0
+/* Sooner still: a probed count whose step's first stage (the forces, the
+ * first loops that split over the threads) took more than EARLY_ABANDON
+ * times the chosen count's runs the rest of that step on the chosen count,
+ * and the probe ends, lost. With one core busy the 10,201-particle drape's
+ * forces took 1.7-3.2 times as long on 2 threads as on 1 (whole steps
+ * 1.8-2.3 times), on an idle machine 0.6-0.8 times (and 1 thread's 1.3-1.6
+ * times 2 threads'); a lost probe then costs a part of its first stage
+ * instead of a whole slow step (each such step cost 1-2 % of a 12-frame
+ * run). Only stages of at least EARLY_MIN_SECONDS on the chosen count are
+ * compared: waking a sleeping thread for the first loop costs tens of
+ * microseconds, which a shorter stage would read as a loss, and a cloth
+ * that small runs its forces on one thread anyway (below WC_PARALLEL_MIN
+ * particles), so its first stage says nothing about the count. */
+#define EARLY_ABANDON 1.25
+#define EARLY_MIN_SECONDS 5e-4
 
 /* A probe runs the chosen count (A) and the probed one (B) in the order
  * A B B A, twice: within each block both get the same sum of step
@@ -63,6 +78,8 @@ void wci_thread_tuner_create(wc_thread_tuner *t, int32_t most, int32_t adapt)
     t->warmup = 2;
     t->recent_count = t->recent_next = t->probe_step = 0;
     t->reference = 0.0;
+    t->stage_chosen = 0.0;
+    t->stage_chosen_steps = t->skip_record = 0;
 }
 
 int32_t wci_thread_tuner_threads(const wc_thread_tuner *t) { return t->current; }
@@ -87,6 +104,8 @@ static void start_probe(wc_thread_tuner *t)
     t->probed = next;
     t->probe_step = 0;
     for (int k = 0; k < 2; ++k) t->block_chosen[k] = t->block_probed[k] = 0.0;
+    t->stage_chosen = 0.0;
+    t->stage_chosen_steps = 0;
     t->current = t->chosen; /* PROBE_ORDER[0] */
 }
 
@@ -159,10 +178,33 @@ static void record_probe_step(wc_thread_tuner *t, double seconds)
     t->current = PROBE_ORDER[t->probe_step] ? t->probed : t->chosen;
 }
 
+int32_t wci_thread_tuner_first_stage(wc_thread_tuner *t, double seconds)
+{
+    if (!t->adapt || !t->probed || t->warmup > 0) return t->current;
+    if (!PROBE_ORDER[t->probe_step]) {
+        t->stage_chosen += seconds;
+        ++t->stage_chosen_steps;
+        return t->current;
+    }
+    double chosen = t->stage_chosen_steps ? t->stage_chosen / t->stage_chosen_steps : 0.0;
+    if (chosen >= EARLY_MIN_SECONDS && seconds > EARLY_ABANDON * chosen) {
+        /* the probed count's extra time so far, in chosen-count steps */
+        double step = chosen_step_time(t);
+        back_off(t, step > 0.0 ? (seconds - chosen) / step : 0.0);
+        finish_probe(t);
+        t->skip_record = 1;
+    }
+    return t->current;
+}
+
 void wci_thread_tuner_record(wc_thread_tuner *t, double seconds)
 {
     WC_ASSERT(t->current >= 1 && t->current <= t->most);
     if (!t->adapt) return;
+    if (t->skip_record) {
+        t->skip_record = 0;
+        return;
+    }
     if (t->warmup > 0) {
         --t->warmup;
         return;

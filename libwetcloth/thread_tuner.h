@@ -12,8 +12,9 @@
  * starts on one thread; a count that keeps winning is probed less and less
  * often, a count that lost by much is probed rarely (its probes are dear),
  * and several threads that suddenly take much longer (the machine got
- * busier) are probed against fewer at once. thread_tuner.c has the rules
- * and why.
+ * busier) are probed against fewer at once. A probe that has clearly lost
+ * by the end of a step's first stage ends there, the rest of the step on
+ * the chosen count. thread_tuner.c has the rules and why.
  *
  * The tuner is a state machine fed with durations, so tests drive it with
  * made-up timings. */
@@ -55,6 +56,13 @@ typedef struct wc_thread_tuner {
     int32_t probe_step;
     double block_chosen[2];
     double block_probed[2];
+    /// The running probe's first-stage times on the chosen count: their
+    /// sum and how many.
+    double stage_chosen;
+    int32_t stage_chosen_steps;
+    /// 1 while a step runs whose probe ended after its first stage: that
+    /// step's time, half on either count, is no sample.
+    int32_t skip_record;
 } wc_thread_tuner;
 
 /// Starts a tuner for up to `most` threads (>= 1), adapting when `adapt`.
@@ -62,6 +70,12 @@ void wci_thread_tuner_create(wc_thread_tuner *tuner, int32_t most, int32_t adapt
 
 /// Threads for the next step.
 int32_t wci_thread_tuner_threads(const wc_thread_tuner *tuner);
+
+/// Records how long the step's first stage (the forces) took on
+/// wci_thread_tuner_threads() threads (seconds), and returns the count for
+/// the rest of the step: the chosen one when a probed count has already
+/// clearly lost.
+int32_t wci_thread_tuner_first_stage(wc_thread_tuner *tuner, double seconds);
 
 /// Records how long the step just taken, on wci_thread_tuner_threads()
 /// threads, took (seconds), and picks the count of the next one.

@@ -442,7 +442,12 @@ static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_
     double *phase = w->phase_seconds, t0 = wci_clock_seconds(), t1;
 
     forces_stage(w, &ctx);
-    t1 = wci_clock_seconds(), phase[0] += t1 - t0, t0 = t1;
+    t1 = wci_clock_seconds(), phase[0] += t1 - t0;
+    /* a probe of another thread count that has clearly lost by now runs
+     * the rest of the step on the chosen count (thread_tuner.c) */
+    ctx.threads = wci_thread_tuner_first_stage(&w->tuner, t1 - t0);
+    w->stats.threads = ctx.threads;
+    t0 = t1;
 
     wc_status s = integrate_stage(w, &ctx);
     if (s) return s;

@@ -117,6 +117,65 @@ static void clearly_lost_probe_ends_at_once(void)
           (int)t.chosen);
 }
 
+/* A probe whose first stage (the forces) on the probed count takes more
+ * than 1.25 times the chosen count's ends after that stage: the rest of
+ * the step runs on the chosen count, that step's time is no sample, and
+ * the next probe comes after the doubled period. A faster first stage, or
+ * one too short to tell (under 0.5 ms on the chosen count), lets the probe
+ * go on. */
+static int32_t probe_first_stages(double chosen_stage, double probed_stage, int32_t *rest_on)
+{
+    wc_thread_tuner t;
+    wci_thread_tuner_create(&t, 2, 1);
+    while (!t.probed) {
+        wci_thread_tuner_first_stage(&t, chosen_stage);
+        wci_thread_tuner_record(&t, 0.020);
+    }
+    int32_t on_two = 0;
+    for (int k = 0; k < 8 && t.probed; ++k) {
+        int32_t n = wci_thread_tuner_threads(&t);
+        int32_t rest = wci_thread_tuner_first_stage(&t, n == 2 ? probed_stage : chosen_stage);
+        on_two += rest == 2;
+        if (n == 2) *rest_on = rest;
+        /* the whole step: slower on 2 threads, as under load */
+        wci_thread_tuner_record(&t, rest == 2 ? 0.045 : 0.020);
+    }
+    CHECK(t.chosen == 1 && !t.probed, "chosen %d, probing %d", (int)t.chosen, (int)t.probed);
+    return on_two;
+}
+
+static void lost_first_stage_ends_the_probe(void)
+{
+    int32_t rest = 0;
+    int32_t on_two = probe_first_stages(0.002, 0.004, &rest);
+    CHECK(on_two == 0 && rest == 1, "slow first stage: %d steps went on on 2 threads, rest on %d",
+          (int)on_two, (int)rest);
+    wc_thread_tuner t;
+    wci_thread_tuner_create(&t, 2, 1);
+    while (!t.probed) {
+        wci_thread_tuner_first_stage(&t, 0.002);
+        wci_thread_tuner_record(&t, 0.020);
+    }
+    wci_thread_tuner_first_stage(&t, 0.002);
+    wci_thread_tuner_record(&t, 0.020);
+    CHECK(wci_thread_tuner_threads(&t) == 2, "second probe step on %d", (int)wci_thread_tuner_threads(&t));
+    CHECK(wci_thread_tuner_first_stage(&t, 0.004) == 1, "rest of the step not on 1 thread");
+    int32_t recent = t.recent_next;
+    wci_thread_tuner_record(&t, 0.031);
+    CHECK(t.recent_next == recent && !t.skip_record, "the mixed step became a sample");
+    CHECK(t.period == 64 && t.until_probe == 64, "period %d, next probe in %d", (int)t.period,
+          (int)t.until_probe);
+    /* a faster first stage: the step goes on on 2 threads (and its
+     * whole time, more than twice the chosen count's, then ends the probe) */
+    on_two = probe_first_stages(0.002, 0.0012, &rest);
+    CHECK(on_two == 1 && rest == 2, "fast first stage: %d steps on 2 threads, rest on %d",
+          (int)on_two, (int)rest);
+    /* a stage too short to tell: not judged by it */
+    on_two = probe_first_stages(0.0002, 0.0004, &rest);
+    CHECK(on_two == 1 && rest == 2, "short first stage: %d steps on 2 threads, rest on %d",
+          (int)on_two, (int)rest);
+}
+
 /* The machine gets busy after the tuner had settled on 2 threads with a
  * long probe period: the slowdown brings the probe forward. */
 static void slowdown_brings_the_probe_forward(void)
@@ -224,6 +283,7 @@ int main(void)
     idle_machine_keeps_two();
     busy_core_moves_to_one_and_back();
     clearly_lost_probe_ends_at_once();
+    lost_first_stage_ends_the_probe();
     slowdown_brings_the_probe_forward();
     sixteen_threads_find_the_free_cores();
     ties_go_to_fewer_threads();
