@@ -1,5 +1,9 @@
 #include "thread_tuner.h"
 
+#include <stddef.h>
+
+#include "idle_cores.h"
+
 #include "invariant.h"
 #include "vec3.h"
 
@@ -53,6 +57,18 @@
  * particles), so its first stage says nothing about the count. */
 #define EARLY_ABANDON 1.25
 #define EARLY_MIN_SECONDS 5e-4
+/* Cheaper than any lost probe is one not run: a probe of more threads
+ * needs, since the last time the tuner asked, at least SPARE_PER_THREAD
+ * idle cores per thread it adds (the system's count, idle_cores.h). With
+ * another program keeping the second of 2 cores busy the count was 0.0-0.1
+ * cores, idle 0.9-1.0; a probe that could win needs the cores, and one that
+ * cannot cost up to a whole step at several times a step's time (the
+ * 10,201-particle drape: 5x), more than EARLY_ABANDON catches when the
+ * forces happen to run well. Skipped, it counts as lost at no cost: the
+ * period doubles as for a lost probe (so a machine that becomes free is
+ * used within BACKOFF_PERIOD steps). Where the count is unknown, probes
+ * run as they would without it. */
+#define SPARE_PER_THREAD 0.5
 
 /* A probe runs the chosen count (A) and the probed one (B) in the order
  * A B B A, twice: within each block both get the same sum of step
@@ -80,6 +96,8 @@ void wci_thread_tuner_create(wc_thread_tuner *t, int32_t most, int32_t adapt)
     t->reference = 0.0;
     t->stage_chosen = 0.0;
     t->stage_chosen_steps = t->skip_record = 0;
+    t->spare_cores = NULL;
+    t->spare_context = NULL;
 }
 
 int32_t wci_thread_tuner_threads(const wc_thread_tuner *t) { return t->current; }
@@ -93,22 +111,6 @@ static int32_t neighbour(const wc_thread_tuner *t, int32_t direction)
     return 2 * t->chosen < t->most ? 2 * t->chosen : t->most;
 }
 
-static void start_probe(wc_thread_tuner *t)
-{
-    int32_t next = neighbour(t, t->direction);
-    if (!next) {
-        t->direction = -t->direction;
-        next = neighbour(t, t->direction);
-    }
-    t->direction = -t->direction; /* alternate, so both ways get tried */
-    t->probed = next;
-    t->probe_step = 0;
-    for (int k = 0; k < 2; ++k) t->block_chosen[k] = t->block_probed[k] = 0.0;
-    t->stage_chosen = 0.0;
-    t->stage_chosen_steps = 0;
-    t->current = t->chosen; /* PROBE_ORDER[0] */
-}
-
 /* After a lost probe: the next one comes after twice the period (up to
  * BACKOFF_PERIOD), or later still when this one cost much, so that lost
  * probes cost about PROBE_COST of the time; `extra` is what the probed
@@ -119,6 +121,35 @@ static void back_off(wc_thread_tuner *t, double extra)
     int32_t period = 2 * t->period < BACKOFF_PERIOD ? 2 * t->period : BACKOFF_PERIOD;
     if (wait > period) period = wait < MAX_PERIOD ? (int32_t)wait : MAX_PERIOD;
     t->period = period;
+}
+
+static void start_probe(wc_thread_tuner *t)
+{
+    int32_t next = neighbour(t, t->direction);
+    if (!next) {
+        t->direction = -t->direction;
+        next = neighbour(t, t->direction);
+    }
+    if (next > t->chosen && t->spare_cores) {
+        double spare = t->spare_cores(t->spare_context);
+        if (spare == WC_IDLE_TOO_SOON) {
+            t->until_probe = FIRST_PROBE;
+            return;
+        }
+        if (spare >= 0.0 && spare < SPARE_PER_THREAD * (next - t->chosen)) {
+            t->direction = -t->direction;
+            back_off(t, 0.0);
+            t->until_probe = t->period;
+            return;
+        }
+    }
+    t->direction = -t->direction; /* alternate, so both ways get tried */
+    t->probed = next;
+    t->probe_step = 0;
+    for (int k = 0; k < 2; ++k) t->block_chosen[k] = t->block_probed[k] = 0.0;
+    t->stage_chosen = 0.0;
+    t->stage_chosen_steps = 0;
+    t->current = t->chosen; /* PROBE_ORDER[0] */
 }
 
 static void finish_probe(wc_thread_tuner *t)

@@ -12,9 +12,11 @@
  * starts on one thread; a count that keeps winning is probed less and less
  * often, a count that lost by much is probed rarely (its probes are dear),
  * and several threads that suddenly take much longer (the machine got
- * busier) are probed against fewer at once. A probe that has clearly lost
- * by the end of a step's first stage ends there, the rest of the step on
- * the chosen count. thread_tuner.c has the rules and why.
+ * busier) are probed against fewer at once. A probe of more threads is
+ * not run while the system says that the cores they would need are busy
+ * (idle_cores.h), and a probe that has clearly lost by the end of a step's
+ * first stage ends there, the rest of the step on the chosen count.
+ * thread_tuner.c has the rules and why.
  *
  * The tuner is a state machine fed with durations, so tests drive it with
  * made-up timings. */
@@ -63,6 +65,12 @@ typedef struct wc_thread_tuner {
     /// 1 while a step runs whose probe ended after its first stage: that
     /// step's time, half on either count, is no sample.
     int32_t skip_record;
+    /// How many cores sat idle since it was last asked, asked before a
+    /// probe of more threads: >= 0, or WC_IDLE_UNKNOWN (the probe runs) or
+    /// WC_IDLE_TOO_SOON (it waits FIRST_PROBE steps); NULL: never asked.
+    /// The world reads the system's count (idle_cores.h), tests make one up.
+    double (*spare_cores)(void *context);
+    void *spare_context;
 } wc_thread_tuner;
 
 /// Starts a tuner for up to `most` threads (>= 1), adapting when `adapt`.

@@ -98,6 +98,9 @@ static wc_status validate_world_def(const wc_world_def *d, wc_message *msg)
     return WC_OK;
 }
 
+/* The thread tuner's question, answered from the system's count. */
+static double idle_cores_of(void *meter) { return wci_idle_meter_read(meter); }
+
 wc_status wc_world_create(const wc_world_def *def, wc_world **out_world, wc_message *out_message)
 {
     if (out_message) out_message->text[0] = '\0';
@@ -113,6 +116,9 @@ wc_status wc_world_create(const wc_world_def *def, wc_world **out_world, wc_mess
     w->def = *def;
     w->tear_ratio = WC_TEAR_RATIO, w->tear_growth = WC_TEAR_GROWTH;
     wci_thread_tuner_create(&w->tuner, wci_thread_count(def->thread_count), def->adapt_threads);
+    wci_idle_meter_start(&w->idle_meter);
+    w->tuner.spare_cores = idle_cores_of;
+    w->tuner.spare_context = &w->idle_meter;
     *out_world = w;
     return WC_OK;
 }

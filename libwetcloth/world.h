@@ -4,6 +4,7 @@
 #include "cloth.h"
 #include "collider.h"
 #include "contact_backup.h"
+#include "idle_cores.h"
 #include "particles.h"
 #include "thread_tuner.h"
 #include "wetcloth.h"
@@ -41,8 +42,10 @@ struct wc_world {
     /// The cloths that collide with each other (cloth_group.h); NULL while
     /// fewer than two do.
     struct wc_cloth_group *group;
-    /// How many threads the next step runs on (thread_tuner.h).
+    /// How many threads the next step runs on (thread_tuner.h), and the
+    /// machine's idle cores it asks for (idle_cores.h).
     wc_thread_tuner tuner;
+    wc_idle_meter idle_meter;
 };
 
 /// The world's message buffer, writable from const entry points.

@@ -10,6 +10,8 @@
 #include <string.h>
 
 #include "test_util.h"
+#include "clock.h"
+#include "idle_cores.h"
 #include "thread_tuner.h"
 #include "wetcloth.h"
 #include "world.h"
@@ -176,6 +178,77 @@ static void lost_first_stage_ends_the_probe(void)
           (int)on_two, (int)rest);
 }
 
+/* The machine's idle cores, made up: a probe of more threads runs only
+ * when at least half a core per added thread sat idle. */
+static double made_up_spare;
+static double spare_of(void *context)
+{
+    (void)context;
+    return made_up_spare;
+}
+
+/* One core busy and the system saying so: no step ever runs on 2 threads
+ * (the probes are skipped at no cost), and once the count shows an idle
+ * core the next probe runs and wins. Where the count comes too soon the
+ * probe waits; where it is unknown the probe runs as without it. */
+static void busy_cores_skip_the_probe(void)
+{
+    wc_thread_tuner t;
+    wci_thread_tuner_create(&t, 2, 1);
+    t.spare_cores = spare_of;
+    made_up_spare = 0.05;
+    run_log busy = drive(&t, 2000, 1, 0.020, 0.030);
+    printf("one core busy, counted: %d steps on 2 threads, period %d\n", busy.steps_at[2],
+           (int)t.period);
+    CHECK(busy.steps_at[2] == 0, "busy: %d steps on 2 threads", busy.steps_at[2]);
+    CHECK(t.period == 1024, "busy: period %d", (int)t.period);
+    made_up_spare = 0.95;
+    run_log idle = drive(&t, 2000, 2, 0.020, 0.030);
+    /* the next probe comes within the period, 1,024 steps, and takes 8 */
+    CHECK(idle.last == 2 && idle.steps_at[2] >= 2000 - 1024 - 8 - WC_TUNER_SAMPLES - 8,
+          "idle again: %d steps on 2, last %d", idle.steps_at[2], idle.last);
+    /* too soon to tell: the first probe waits 8 steps more, then runs */
+    wci_thread_tuner_create(&t, 2, 1);
+    t.spare_cores = spare_of;
+    made_up_spare = WC_IDLE_TOO_SOON;
+    int32_t steps = 0;
+    for (; steps < 12; ++steps) wci_thread_tuner_record(&t, 0.020);
+    CHECK(!t.probed && t.until_probe == 8, "too soon: probing %d, next in %d", (int)t.probed,
+          (int)t.until_probe);
+    made_up_spare = WC_IDLE_UNKNOWN;
+    for (; steps < 20; ++steps) wci_thread_tuner_record(&t, 0.020);
+    CHECK(t.probed == 2, "unknown: no probe after %d steps", (int)steps);
+}
+
+/* The system's count over a tenth of a second in which this thread kept a
+ * core busy: at least one core fewer than the machine has were idle. Too
+ * soon after, it says so. */
+static void idle_meter_counts_a_busy_core(void)
+{
+    wc_idle_meter m;
+    wci_idle_meter_start(&m);
+    double start = wci_clock_seconds(), spin = 0.0;
+    CHECK(wci_idle_meter_read(&m) == WC_IDLE_TOO_SOON, "a read at once is not too soon");
+    while (wci_clock_seconds() - start < 1.5 * WC_IDLE_MIN_WINDOW) spin += 1.0;
+    double spare = wci_idle_meter_read(&m);
+    int processors = 0;
+#ifdef __linux__
+    FILE *f = fopen("/proc/stat", "r");
+    char line[4096];
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, "cpu", 3) && line[3] >= '0' && line[3] <= '9') ++processors;
+    if (f) fclose(f);
+    CHECK(spare != WC_IDLE_UNKNOWN, "no count on Linux");
+#endif
+    printf("idle cores while one spun (%.0f turns): %g of %d\n", spin, spare, processors);
+    if (spare == WC_IDLE_UNKNOWN) return;
+    CHECK(spare >= 0.0, "%g idle cores", spare);
+    /* a 10 ms tick per processor over 0.15 s: within 0.07 cores each */
+    if (processors > 0)
+        CHECK(spare <= processors - 1 + 0.07 * processors, "%g idle cores of %d while one spun",
+              spare, processors);
+}
+
 /* The machine gets busy after the tuner had settled on 2 threads with a
  * long probe period: the slowdown brings the probe forward. */
 static void slowdown_brings_the_probe_forward(void)
@@ -284,6 +357,8 @@ int main(void)
     busy_core_moves_to_one_and_back();
     clearly_lost_probe_ends_at_once();
     lost_first_stage_ends_the_probe();
+    busy_cores_skip_the_probe();
+    idle_meter_counts_a_busy_core();
     slowdown_brings_the_probe_forward();
     sixteen_threads_find_the_free_cores();
     ties_go_to_fewer_threads();
