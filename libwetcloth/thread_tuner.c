@@ -42,19 +42,19 @@
  * 4-step probe took 65-80 ms against 5.5-6, one that ends it after its
  * first step 46-49). */
 #define ABANDON 2.0
-/* Sooner still: a probed count whose step's first stage (the forces, the
- * first loops that split over the threads) took more than EARLY_ABANDON
- * times the chosen count's runs the rest of that step on the chosen count,
- * and the probe ends, lost. With one core busy the 10,201-particle drape's
- * forces took 1.7-3.2 times as long on 2 threads as on 1 (whole steps
- * 1.8-2.3 times), on an idle machine 0.6-0.8 times (and 1 thread's 1.3-1.6
- * times 2 threads'); a lost probe then costs a part of its first stage
- * instead of a whole slow step (each such step cost 1-2 % of a 12-frame
- * run). Only stages of at least EARLY_MIN_SECONDS on the chosen count are
- * compared: waking a sleeping thread for the first loop costs tens of
- * microseconds, which a shorter stage would read as a loss, and a cloth
- * that small runs its forces on one thread anyway (below WC_PARALLEL_MIN
- * particles), so its first stage says nothing about the count. */
+/* Sooner still: a probe of fewer threads whose step's first stage (the
+ * forces, the first loops that split over the threads) took more than
+ * EARLY_ABANDON times the chosen count's runs the rest of that step on the
+ * chosen count, and the probe ends, lost. On an idle machine the
+ * 10,201-particle drape's forces took 1.3-1.6 times as long on 1 thread as
+ * on 2, and a probe of 1 thread ran 4 steps on it (in contact about 13 ms
+ * more each). Only probes of fewer threads: their threads ran the last
+ * step too, while a probe of more starts threads whose caches are cold,
+ * and its first step's forces took 1.6-1.9 times one thread's on an idle
+ * machine, where later steps take 0.6-0.8 times (design-notes.md). Only
+ * stages of at least EARLY_MIN_SECONDS on the chosen count are compared:
+ * a cloth whose forces are shorter runs them on one thread anyway (below
+ * WC_PARALLEL_MIN particles), so they say nothing about the count. */
 #define EARLY_ABANDON 1.25
 #define EARLY_MIN_SECONDS 5e-4
 /* Cheaper than any lost probe is one not run: a probe of more threads
@@ -63,8 +63,7 @@
  * another program keeping the second of 2 cores busy the count was 0.0-0.1
  * cores, idle 0.9-1.0; a probe that could win needs the cores, and one that
  * cannot cost up to a whole step at several times a step's time (the
- * 10,201-particle drape: 5x), more than EARLY_ABANDON catches when the
- * forces happen to run well. Skipped, it counts as lost at no cost: the
+ * 10,201-particle drape: 5x). Skipped, it counts as lost at no cost: the
  * period doubles as for a lost probe (so a machine that becomes free is
  * used within BACKOFF_PERIOD steps). Where the count is unknown, probes
  * run as they would without it. */
@@ -211,7 +210,7 @@ static void record_probe_step(wc_thread_tuner *t, double seconds)
 
 int32_t wci_thread_tuner_first_stage(wc_thread_tuner *t, double seconds)
 {
-    if (!t->adapt || !t->probed || t->warmup > 0) return t->current;
+    if (!t->adapt || !t->probed || t->probed > t->chosen || t->warmup > 0) return t->current;
     if (!PROBE_ORDER[t->probe_step]) {
         t->stage_chosen += seconds;
         ++t->stage_chosen_steps;

@@ -14,8 +14,9 @@
  * and several threads that suddenly take much longer (the machine got
  * busier) are probed against fewer at once. A probe of more threads is
  * not run while the system says that the cores they would need are busy
- * (idle_cores.h), and a probe that has clearly lost by the end of a step's
- * first stage ends there, the rest of the step on the chosen count.
+ * (idle_cores.h), and a probe of fewer threads that has clearly lost by the
+ * end of a step's first stage ends there, the rest of the step on the
+ * chosen count.
  * thread_tuner.c has the rules and why.
  *
  * The tuner is a state machine fed with durations, so tests drive it with
@@ -59,7 +60,7 @@ typedef struct wc_thread_tuner {
     double block_chosen[2];
     double block_probed[2];
     /// The running probe's first-stage times on the chosen count: their
-    /// sum and how many.
+    /// sum and how many (probes of fewer threads).
     double stage_chosen;
     int32_t stage_chosen_steps;
     /// 1 while a step runs whose probe ended after its first stage: that
@@ -81,8 +82,8 @@ int32_t wci_thread_tuner_threads(const wc_thread_tuner *tuner);
 
 /// Records how long the step's first stage (the forces) took on
 /// wci_thread_tuner_threads() threads (seconds), and returns the count for
-/// the rest of the step: the chosen one when a probed count has already
-/// clearly lost.
+/// the rest of the step: the chosen one when a probe of fewer threads has
+/// already clearly lost.
 int32_t wci_thread_tuner_first_stage(wc_thread_tuner *tuner, double seconds);
 
 /// Records how long the step just taken, on wci_thread_tuner_threads()

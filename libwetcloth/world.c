@@ -98,6 +98,12 @@ static wc_status validate_world_def(const wc_world_def *d, wc_message *msg)
     return WC_OK;
 }
 
+static void no_work(void *context, const wc_team *team)
+{
+    (void)context;
+    (void)team;
+}
+
 /* The thread tuner's question, answered from the system's count. */
 static double idle_cores_of(void *meter) { return wci_idle_meter_read(meter); }
 
@@ -119,6 +125,10 @@ wc_status wc_world_create(const wc_world_def *def, wc_world **out_world, wc_mess
     wci_idle_meter_start(&w->idle_meter);
     w->tuner.spare_cores = idle_cores_of;
     w->tuner.spare_context = &w->idle_meter;
+    /* The threads are made now, not in the first step that probes more of
+     * them: making them takes milliseconds, which that step's time would
+     * count against them. */
+    if (w->tuner.adapt) wci_parallel_team(w->tuner.most, no_work, NULL);
     *out_world = w;
     return WC_OK;
 }
@@ -449,8 +459,8 @@ static wc_status world_step(wc_world *w, double dt, double share, int32_t steps_
 
     forces_stage(w, &ctx);
     t1 = wci_clock_seconds(), phase[0] += t1 - t0;
-    /* a probe of another thread count that has clearly lost by now runs
-     * the rest of the step on the chosen count (thread_tuner.c) */
+    /* a probe of fewer threads that has clearly lost by now runs the rest
+     * of the step on the chosen count (thread_tuner.c) */
     ctx.threads = wci_thread_tuner_first_stage(&w->tuner, t1 - t0);
     w->stats.threads = ctx.threads;
     t0 = t1;

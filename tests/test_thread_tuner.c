@@ -119,63 +119,65 @@ static void clearly_lost_probe_ends_at_once(void)
           (int)t.chosen);
 }
 
-/* A probe whose first stage (the forces) on the probed count takes more
- * than 1.25 times the chosen count's ends after that stage: the rest of
- * the step runs on the chosen count, that step's time is no sample, and
- * the next probe comes after the doubled period. A faster first stage, or
- * one too short to tell (under 0.5 ms on the chosen count), lets the probe
- * go on. */
-static int32_t probe_first_stages(double chosen_stage, double probed_stage, int32_t *rest_on)
+/* A tuner settled on 2 threads of 2 (first stages of 0.6 ms and steps of
+ * 12 ms on 2 threads, 1 ms and 20 ms on 1), at the start of a probe of 1. */
+static void settled_on_two(wc_thread_tuner *t, double two_stage)
 {
-    wc_thread_tuner t;
-    wci_thread_tuner_create(&t, 2, 1);
-    while (!t.probed) {
-        wci_thread_tuner_first_stage(&t, chosen_stage);
-        wci_thread_tuner_record(&t, 0.020);
+    wci_thread_tuner_create(t, 2, 1);
+    for (int32_t s = 0; s < 100000 && !(t->chosen == 2 && t->probed == 1); ++s) {
+        int32_t n = wci_thread_tuner_threads(t);
+        n = wci_thread_tuner_first_stage(t, n == 2 ? two_stage : 0.001);
+        wci_thread_tuner_record(t, n == 2 ? 0.012 : 0.020);
     }
-    int32_t on_two = 0;
-    for (int k = 0; k < 8 && t.probed; ++k) {
-        int32_t n = wci_thread_tuner_threads(&t);
-        int32_t rest = wci_thread_tuner_first_stage(&t, n == 2 ? probed_stage : chosen_stage);
-        on_two += rest == 2;
-        if (n == 2) *rest_on = rest;
-        /* the whole step: slower on 2 threads, as under load */
-        wci_thread_tuner_record(&t, rest == 2 ? 0.045 : 0.020);
-    }
-    CHECK(t.chosen == 1 && !t.probed, "chosen %d, probing %d", (int)t.chosen, (int)t.probed);
-    return on_two;
+    CHECK(t->chosen == 2 && t->probed == 1, "not settled on 2 threads: chosen %d, probing %d",
+          (int)t->chosen, (int)t->probed);
 }
 
+/* A probe of fewer threads whose first stage (the forces) takes more than
+ * 1.25 times the chosen count's ends after that stage: the rest of the
+ * step runs on the chosen count, that step's time is no sample, and the
+ * next probe comes after the doubled period. A first stage that is not
+ * that much slower, or too short to tell (under 0.5 ms on the chosen
+ * count), lets the probe go on; and a probe of more threads is never ended
+ * by its first stage (its new threads start with cold caches). */
 static void lost_first_stage_ends_the_probe(void)
 {
-    int32_t rest = 0;
-    int32_t on_two = probe_first_stages(0.002, 0.004, &rest);
-    CHECK(on_two == 0 && rest == 1, "slow first stage: %d steps went on on 2 threads, rest on %d",
-          (int)on_two, (int)rest);
     wc_thread_tuner t;
+    settled_on_two(&t, 0.0006);
+    int32_t period = t.period;
+    CHECK(wci_thread_tuner_threads(&t) == 2 && wci_thread_tuner_first_stage(&t, 0.0006) == 2,
+          "the probe's first step is not on the chosen 2 threads");
+    wci_thread_tuner_record(&t, 0.012);
+    CHECK(wci_thread_tuner_threads(&t) == 1, "the probe's second step on %d threads",
+          (int)wci_thread_tuner_threads(&t));
+    CHECK(wci_thread_tuner_first_stage(&t, 0.001) == 2, "the rest of the step not on 2 threads");
+    int32_t recent = t.recent_next;
+    wci_thread_tuner_record(&t, 0.016);
+    CHECK(!t.probed && t.chosen == 2 && t.recent_next == recent && !t.skip_record,
+          "after the lost stage: probing %d, chosen %d, the mixed step a sample: %d", (int)t.probed,
+          (int)t.chosen, t.recent_next != recent);
+    CHECK(t.period == (2 * period < 1024 ? 2 * period : 1024) && t.until_probe == t.period,
+          "period %d (was %d), next probe in %d", (int)t.period, (int)period, (int)t.until_probe);
+    /* 1.2 times as long: the step goes on on 1 thread */
+    settled_on_two(&t, 0.0006);
+    wci_thread_tuner_first_stage(&t, 0.0006);
+    wci_thread_tuner_record(&t, 0.012);
+    CHECK(wci_thread_tuner_first_stage(&t, 0.00072) == 1, "a first stage 1.2x as long ended it");
+    /* too short to tell */
+    settled_on_two(&t, 0.0002);
+    wci_thread_tuner_first_stage(&t, 0.0002);
+    wci_thread_tuner_record(&t, 0.012);
+    CHECK(wci_thread_tuner_first_stage(&t, 0.0004) == 1, "a 0.2 ms first stage ended it");
+    /* a probe of more threads, its first stage 3 times one thread's */
     wci_thread_tuner_create(&t, 2, 1);
     while (!t.probed) {
-        wci_thread_tuner_first_stage(&t, 0.002);
+        wci_thread_tuner_first_stage(&t, 0.001);
         wci_thread_tuner_record(&t, 0.020);
     }
-    wci_thread_tuner_first_stage(&t, 0.002);
+    wci_thread_tuner_first_stage(&t, 0.001);
     wci_thread_tuner_record(&t, 0.020);
-    CHECK(wci_thread_tuner_threads(&t) == 2, "second probe step on %d", (int)wci_thread_tuner_threads(&t));
-    CHECK(wci_thread_tuner_first_stage(&t, 0.004) == 1, "rest of the step not on 1 thread");
-    int32_t recent = t.recent_next;
-    wci_thread_tuner_record(&t, 0.031);
-    CHECK(t.recent_next == recent && !t.skip_record, "the mixed step became a sample");
-    CHECK(t.period == 64 && t.until_probe == 64, "period %d, next probe in %d", (int)t.period,
-          (int)t.until_probe);
-    /* a faster first stage: the step goes on on 2 threads (and its
-     * whole time, more than twice the chosen count's, then ends the probe) */
-    on_two = probe_first_stages(0.002, 0.0012, &rest);
-    CHECK(on_two == 1 && rest == 2, "fast first stage: %d steps on 2 threads, rest on %d",
-          (int)on_two, (int)rest);
-    /* a stage too short to tell: not judged by it */
-    on_two = probe_first_stages(0.0002, 0.0004, &rest);
-    CHECK(on_two == 1 && rest == 2, "short first stage: %d steps on 2 threads, rest on %d",
-          (int)on_two, (int)rest);
+    CHECK(wci_thread_tuner_threads(&t) == 2 && wci_thread_tuner_first_stage(&t, 0.003) == 2,
+          "a probe of more threads ended by its first stage");
 }
 
 /* The machine's idle cores, made up: a probe of more threads runs only
