@@ -46,7 +46,7 @@
  * forces, the first loops that split over the threads) took more than
  * EARLY_ABANDON times the chosen count's runs the rest of that step on the
  * chosen count, and the probe ends, lost. On an idle machine the
- * 10,201-particle drape's forces took 1.3-1.6 times as long on 1 thread as
+ * 10,201-particle drape's forces took 1.3-2.7 times as long on 1 thread as
  * on 2, and a probe of 1 thread ran 4 steps on it (in contact about 13 ms
  * more each). Only probes of fewer threads: their threads ran the last
  * step too, while a probe of more starts threads whose caches are cold,
