@@ -152,9 +152,11 @@ typedef struct wc_world_def {
     /// thread_count threads whenever that is faster: when other programs
     /// keep cores busy (a thread the scheduler takes away holds up every
     /// barrier of the step), or when a cloth is too small to share. It
-    /// probes a neighbouring count now and then and keeps the faster. The
-    /// results are the same bits for any thread count, so this changes only
-    /// the time. 0: always thread_count threads (for measuring scaling).
+    /// probes a neighbouring count now and then and keeps the faster, and
+    /// does not try more threads while the system counts the cores they
+    /// would need as busy. The results are the same bits for any thread
+    /// count, so this changes only the time. 0: always thread_count threads
+    /// (for measuring scaling).
     int32_t adapt_threads;
 } wc_world_def;
 
