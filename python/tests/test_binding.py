@@ -65,6 +65,25 @@ def test_environment_override_to_a_missing_file_is_an_error(tmp_path):
     assert "WETCLOTH_LIBRARY" in r.stderr and "nothing.so" in r.stderr
 
 
+def test_a_process_that_ran_threads_exits_cleanly():
+    """A world that ran on 2 threads leaves OpenMP's workers behind; with
+    OMP_WAIT_POLICY=active they spin in the runtime's code until the process
+    ends. The interpreter's shutdown frees the library handle, and the
+    library (with the runtime) must stay mapped for them: before it did, the
+    process crashed on its way out every time (exit status -11)."""
+    code = ("import wetcloth\n"
+            "w = wetcloth.World(threads=2, adapt_threads=False)\n"
+            "w.add_grid_cloth(64, 64, size=(1, 1), center=(0, 0, 1))\n"
+            "w.advance(1 / 24, 2)\n"
+            "print(w.stats['threads'])\n")
+    env = dict(os.environ, OMP_WAIT_POLICY="active")
+    for _ in range(3):
+        r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                           timeout=120)
+        assert r.returncode == 0, (r.returncode, r.stdout, r.stderr)
+        assert r.stdout.strip() == "2", r.stdout
+
+
 def test_every_struct_of_the_binding_has_the_libraries_size():
     from wetcloth import _lib
     structs = _lib.declared_structs(wetcloth.ffi)

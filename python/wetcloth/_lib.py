@@ -59,7 +59,30 @@ def load(package_path):
             "0.x versions must match in major and minor" %
             (path, ffi.string(lib.wc_version_string()).decode(), major, minor))
     check_struct_sizes(lib, ffi, path)
+    keep_loaded(path)
     return lib, path
+
+
+_kept = []
+
+
+def keep_loaded(path):
+    """Keeps the library, and the OpenMP runtime it brings, mapped until the
+    process ends. cffi unloads a library when its handle is freed, which
+    Python's shutdown does; but a world that ran on several threads leaves
+    OpenMP's worker threads behind, waiting (spinning for a while) in code
+    that the unloading unmaps, and the process then crashed on its way out
+    (a 2-thread world with OMP_WAIT_POLICY=active: every time; with the
+    default policy and the machine busy: about one run in two). A second
+    reference that is never released (ctypes never closes its handles),
+    with RTLD_NODELETE where the system has it, keeps it mapped."""
+    import ctypes
+    mode = getattr(os, "RTLD_NOW", 0) | getattr(os, "RTLD_NODELETE", 0)
+    try:
+        _kept.append(ctypes.CDLL(os.path.abspath(path), mode=mode) if mode
+                     else ctypes.CDLL(os.path.abspath(path)))
+    except OSError as e:
+        raise ImportError("cannot load libwetcloth from %s: %s" % (path, e)) from None
 
 
 def declared_structs(binding):
