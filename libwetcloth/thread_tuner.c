@@ -129,20 +129,19 @@ static void start_probe(wc_thread_tuner *t)
         t->direction = -t->direction;
         next = neighbour(t, t->direction);
     }
-    if (next > t->chosen && t->spare_cores) {
-        double spare = t->spare_cores(t->spare_context);
-        if (spare == WC_IDLE_TOO_SOON) {
-            t->until_probe = FIRST_PROBE;
-            return;
-        }
-        if (spare >= 0.0 && spare < SPARE_PER_THREAD * (next - t->chosen)) {
-            t->direction = -t->direction;
-            back_off(t, 0.0);
-            t->until_probe = t->period;
-            return;
-        }
+    double spare = next > t->chosen && t->spare_cores ? t->spare_cores(t->spare_context)
+                                                      : WC_IDLE_UNKNOWN;
+    if (spare == WC_IDLE_TOO_SOON) {
+        t->until_probe = FIRST_PROBE;
+        return;
     }
     t->direction = -t->direction; /* alternate, so both ways get tried */
+    if (spare >= 0.0 && spare < SPARE_PER_THREAD * (next - t->chosen)) {
+        /* the cores it needs are busy: lost, at no cost */
+        back_off(t, 0.0);
+        t->until_probe = t->period;
+        return;
+    }
     t->probed = next;
     t->probe_step = 0;
     for (int k = 0; k < 2; ++k) t->block_chosen[k] = t->block_probed[k] = 0.0;
