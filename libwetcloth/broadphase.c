@@ -230,36 +230,60 @@ int32_t wci_bvh_query(const wc_bvh *b, const double box[6], int32_t *out, int32_
     return found;
 }
 
-void wci_bvh_fold_max(const wc_bvh *b, const double *item_values, double *node_values)
+static void box_join(double *into, const double *box)
+{
+    for (int k = 0; k < 3; ++k) {
+        if (box[k] < into[k]) into[k] = box[k];
+        if (box[k + 3] > into[k + 3]) into[k + 3] = box[k + 3];
+    }
+}
+
+static int box_holds(const double *outer, const double *inner)
+{
+    for (int k = 0; k < 3; ++k)
+        if (inner[k] < outer[k] || inner[k + 3] > outer[k + 3]) return 0;
+    return 1;
+}
+
+static void box_empty(double *box)
+{
+    for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
+}
+
+void wci_bvh_fold_boxes(const wc_bvh *b, const double *item_boxes, double *node_boxes)
 {
     /* children come after their parent (wci_bvh_create) */
     for (int32_t k = b->node_count - 1; k >= 0; --k) {
         const wc_bvh_node *node = b->nodes + k;
-        double most = 0.0;
+        double *out = node_boxes + 6 * (size_t)k;
+        box_empty(out);
         if (node->count == 0) {
-            double l = node_values[node->first], r = node_values[node->first + 1];
-            most = l > r ? l : r;
+            box_join(out, node_boxes + 6 * (size_t)node->first);
+            box_join(out, node_boxes + 6 * ((size_t)node->first + 1));
         } else {
-            for (int32_t j = 0; j < node->count; ++j) {
-                double v = item_values[b->order[node->first + j]];
-                if (v > most) most = v;
-            }
+            for (int32_t j = 0; j < node->count; ++j)
+                box_join(out, item_boxes + 6 * (size_t)b->order[node->first + j]);
         }
-        node_values[k] = most;
     }
 }
 
-double wci_bvh_most_within(const wc_bvh *b, const double *item_values, const double *node_values,
-                           const double box[6])
+int wci_bvh_union_within(const wc_bvh *b, const double *item_boxes, const double *node_boxes,
+                         const double box[6], double out[6])
 {
-    if (b->node_count == 0) return 0.0;
+    box_empty(out);
+    if (b->node_count == 0) return 0;
     int32_t stack[STACK_DEPTH], depth = 0;
-    double most = 0.0;
+    int any = 0;
     stack[depth++] = 0;
     while (depth > 0) {
         int32_t k = stack[--depth];
         const wc_bvh_node *node = b->nodes + k;
-        if (!(node_values[k] > most) || !overlap(node->box, box)) continue;
+        if ((any && box_holds(out, node_boxes + 6 * (size_t)k)) || !overlap(node->box, box)) continue;
+        /* a node inside the box: every item of it overlaps, its value box is theirs */
+        if (box_holds(box, node->box)) {
+            box_join(out, node_boxes + 6 * (size_t)k), any = 1;
+            continue;
+        }
         if (node->count == 0) {
             stack[depth++] = node->first + 1;
             stack[depth++] = node->first;
@@ -267,11 +291,10 @@ double wci_bvh_most_within(const wc_bvh *b, const double *item_values, const dou
         }
         for (int32_t j = 0; j < node->count; ++j) {
             int32_t item = b->order[node->first + j];
-            if (item_values[item] > most && overlap(b->boxes + 6 * (size_t)item, box))
-                most = item_values[item];
+            if (overlap(b->boxes + 6 * (size_t)item, box)) box_join(out, item_boxes + 6 * (size_t)item), any = 1;
         }
     }
-    return most;
+    return any;
 }
 
 double wci_bvh_root_distance(const wc_bvh *b, const double p[3])

@@ -64,16 +64,19 @@ int32_t wci_bvh_query(const wc_bvh *bvh, const double box[6], int32_t *out, int3
 /// they keep of it themselves.
 int32_t wci_bvh_collect(const wc_bvh *bvh, const double box[6], int32_t *out, int32_t capacity);
 
-/// After the items' values changed: each node's value becomes the largest
-/// of its items' (`item_values` per item, `node_values` per node, >= 0).
-void wci_bvh_fold_max(const wc_bvh *bvh, const double *item_values, double *node_values);
+/// After the items' value boxes changed: each node's value box becomes the
+/// union of its items' (`item_boxes` and `node_boxes` hold 6 doubles each,
+/// min xyz then max xyz). A value box is any box attached to an item, apart
+/// from the item's box in space: the collider's is the box of its
+/// vertices' displacements in a step (collider.h).
+void wci_bvh_fold_boxes(const wc_bvh *bvh, const double *item_boxes, double *node_boxes);
 
-/// The largest value of the items whose boxes overlap `box` (0 if none),
-/// with the node values that wci_bvh_fold_max made from the same item
-/// values: a branch and bound that skips every node whose value cannot
-/// raise the answer.
-double wci_bvh_most_within(const wc_bvh *bvh, const double *item_values, const double *node_values,
-                           const double box[6]);
+/// The union of the value boxes of the items whose boxes overlap `box`, into
+/// `out`; returns 0 (and leaves `out` empty: min > max) if there are none.
+/// Uses the node value boxes that wci_bvh_fold_boxes made from the same item
+/// boxes to skip every node whose value box the union already holds.
+int wci_bvh_union_within(const wc_bvh *bvh, const double *item_boxes, const double *node_boxes,
+                         const double box[6], double out[6]);
 
 /// Distance from point p to the tree's root box (0 inside it; +inf for an
 /// empty tree): no item is nearer.

@@ -27,6 +27,11 @@
 #define MARGIN_FEATURES 0.5
 /* A margin covers this many times the motion expected until the frame ends. */
 #define MARGIN_AHEAD 1.5
+/* The most a particle's local step can be, in step motions S: its frame's
+ * step is the centre of a box of displacements no longer than S, so both
+ * lie in the cube of half-side S, and a displacement is no farther from it
+ * than that cube's diagonal, 2 sqrt(3) S. */
+#define LOCAL_STEP_MOST 3.5
 
 
 static void makers_free(wc_candidates *c);
@@ -42,6 +47,7 @@ void wci_candidates_destroy(wc_candidates *c)
 {
     wci_free(c->base), wci_free(c->margin), wci_free(c->base_path);
     wci_free(c->local_path), wci_free(c->local_step), wci_free(c->particle_mark);
+    wci_free(c->frame), wci_free(c->frame_step), wci_free(c->own_step), wci_free(c->again);
     lists_free(&c->particles), lists_free(&c->triangles), lists_free(&c->edges);
     makers_free(c);
     wci_free(c->jobs);
@@ -289,7 +295,24 @@ static int keep_sorted(wc_list_maker *m, wc_list_job *job, pair_entry *e, int32_
     return 1;
 }
 
-static void base_of(const wc_candidates *c, int32_t i, double out[3]) { vertex_of(c->base, i, out); }
+/* Particle i's frame at the start of the step (end 0) or at its end (1). */
+static void frame_of(const wc_candidates *c, int32_t i, int end, double out[3])
+{
+    if (!c->framed) {
+        out[0] = out[1] = out[2] = 0.0;
+        return;
+    }
+    for (int k = 0; k < 3; ++k)
+        out[k] = c->frame[3 * (size_t)i + k] + (end ? c->frame_step[3 * (size_t)i + k] : 0.0);
+}
+
+/* Particle i's base where its frame has carried it by the start of the
+ * step: where its lists are measured from. */
+static void base_of(const wc_candidates *c, int32_t i, double out[3])
+{
+    frame_of(c, i, 0, out);
+    for (int k = 0; k < 3; ++k) out[k] += c->base[3 * (size_t)i + k];
+}
 
 static double element_margin(const wc_candidates *c, const int32_t *idx, int count)
 {
@@ -445,14 +468,14 @@ static int put_list(wc_candidates *c, const wc_cloth_elements *el, const wc_list
     const double *d0 = job->count ? m->d0 + job->at : NULL;
     double snap[9];
     if (job->kind == LIST_PARTICLE) {
-        base_of(c, job->owner, snap);
+        vertex_of(c->base, job->owner, snap);
         return lists_put(&c->particles, job->owner, items, d0, job->count,
                          c->base_path[job->owner], snap);
     }
     int per = job->kind == LIST_TRIANGLE ? 3 : 2;
     const int32_t *idx = per == 3 ? el->triangles + 3 * (size_t)job->owner
                                   : el->edges + 2 * (size_t)job->owner;
-    for (int k = 0; k < per; ++k) base_of(c, idx[k], snap + 3 * k);
+    for (int k = 0; k < per; ++k) vertex_of(c->base, idx[k], snap + 3 * k);
     return lists_put(per == 3 ? &c->triangles : &c->edges, job->owner, items, d0, job->count,
                      c->local_path[idx[0]], snap);
 }
@@ -503,21 +526,29 @@ static void add_job(wc_candidates *c, int32_t *count, list_kind kind, int32_t ow
     ++*count;
 }
 
-/* New base (the start of the step) and margin for particle i. Its margin
- * must cover this step at once (its motion and the collider's), and is made
- * to cover MARGIN_AHEAD times the motion expected until the frame ends,
- * within [MARGIN_LOW r, MARGIN_HIGH r]. A particle far from the collider
- * gets no more: its triangles' and edges' lists take the largest margin of
- * their particles, and a margin as large as the gap to the collider made
- * their queries sweep much of it (measured: the soaked 2 m cloth falling
- * past the sphere spent most of its step making lists); a rebase far from
- * everything costs a query that stops at the tree's root. */
+/* New base (the start of the step, in its frame) and margin for particle
+ * i. Its margin must cover this step at once, and is made to cover
+ * MARGIN_AHEAD times the motion expected until the frame ends, within
+ * [MARGIN_LOW r, MARGIN_HIGH r]; both counted relative to its frame (its
+ * own motion less its frame's, plus the collider's local step). A particle
+ * far from the collider gets no more: its triangles' and edges' lists take
+ * the largest margin of their particles, and a margin as large as the gap
+ * to the collider made their queries sweep much of it (measured: the soaked
+ * 2 m cloth falling past the sphere spent most of its step making lists); a
+ * rebase far from everything costs a query that stops at the tree's root.
+ * A rebase widens the cubes of its neighbours (their reach takes its
+ * margin), so their local steps may rise after it: `worst` makes the
+ * margin cover the most a local step can be (LOCAL_STEP_MOST), for a
+ * particle that such a rise already pushed out of its cover once. */
 static void rebase_one(wc_candidates *c, const wc_collider *col, int32_t i,
-                       const wc_particle_arrays *pa, int32_t steps_left)
+                       const wc_particle_arrays *pa, int32_t steps_left, int worst)
 {
-    double p[3] = {pa->x[i], pa->y[i], pa->z[i]}, r = c->r;
-    double d[3] = {pa->nx[i] - p[0], pa->ny[i] - p[1], pa->nz[i] - p[2]};
-    double now = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + col->step_motion;
+    double f[3], e[3], p[3] = {pa->x[i], pa->y[i], pa->z[i]}, r = c->r;
+    frame_of(c, i, 0, f), frame_of(c, i, 1, e);
+    double d[3] = {pa->nx[i] - e[0] - p[0] + f[0], pa->ny[i] - e[1] - p[1] + f[1],
+                   pa->nz[i] - e[2] - p[2] + f[2]};
+    double own = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    double now = own + (worst ? LOCAL_STEP_MOST * col->step_motion : c->local_step[i]);
     double m = MARGIN_AHEAD * now * (1.0 + (steps_left > 0 ? steps_left : 0));
     if (m < MARGIN_LOW * r) m = MARGIN_LOW * r;
     double feature = MARGIN_FEATURES * col->feature_size;
@@ -526,7 +557,7 @@ static void rebase_one(wc_candidates *c, const wc_collider *col, int32_t i,
     if (m < MARGIN_AHEAD * now) m = MARGIN_AHEAD * now;
     /* strictly above this step's own motion, even when it is zero */
     if (!(m > now)) m = now + MARGIN_LOW * r + 1e-12;
-    c->base[3 * (size_t)i] = p[0], c->base[3 * (size_t)i + 1] = p[1], c->base[3 * (size_t)i + 2] = p[2];
+    for (int k = 0; k < 3; ++k) c->base[3 * (size_t)i + k] = p[k] - f[k];
     c->margin[i] = m;
     c->base_path[i] = c->local_path[i];
 }
@@ -541,7 +572,12 @@ static int allocate(wc_candidates *c, const wc_cloth_elements *el)
     if (!c->local_path) c->local_path = wci_alloc_array(n, sizeof *c->local_path);
     if (!c->local_step) c->local_step = wci_alloc_array(n, sizeof *c->local_step);
     if (!c->particle_mark) c->particle_mark = wci_alloc_array(n, 1);
-    return c->base && c->margin && c->base_path && c->local_path && c->local_step && c->particle_mark;
+    if (!c->frame) c->frame = wci_alloc_array(3 * n, sizeof *c->frame);
+    if (!c->frame_step) c->frame_step = wci_alloc_array(3 * n, sizeof *c->frame_step);
+    if (!c->own_step) c->own_step = wci_alloc_array(n, sizeof *c->own_step);
+    if (!c->again) c->again = wci_alloc_array(2 * n, sizeof *c->again);
+    return c->base && c->margin && c->base_path && c->local_path && c->local_step && c->particle_mark &&
+           c->frame && c->frame_step && c->own_step && c->again;
 }
 
 wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
@@ -554,8 +590,12 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
         return WC_ERROR_OUT_OF_MEMORY;
     c->r = r;
     c->feature_r = WC_FEATURE_DISTANCE * r;
-    for (int32_t i = 0; i < el->particle_count; ++i) c->local_path[i] = 0.0, c->local_step[i] = 0.0;
-    for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, i, p, steps_left);
+    for (int32_t i = 0; i < el->particle_count; ++i) {
+        c->local_path[i] = 0.0, c->local_step[i] = 0.0;
+        for (int k = 0; k < 3; ++k) c->frame[3 * (size_t)i + k] = 0.0, c->frame_step[3 * (size_t)i + k] = 0.0;
+    }
+    c->framed = 0;
+    for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, i, p, steps_left, 1);
     int32_t count = 0;
     for (int32_t i = 0; i < el->particle_count; ++i) add_job(c, &count, LIST_PARTICLE, i);
     for (int32_t t = 0; t < el->triangle_count; ++t) add_job(c, &count, LIST_TRIANGLE, t);
@@ -564,13 +604,23 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
         c->r = 0.0; /* made again at the next use */
         return WC_ERROR_OUT_OF_MEMORY;
     }
-    wci_candidates_local_motion(c, el, col, NULL, el->particle_count);
+    wci_candidates_local_motion(c, el, col);
     return WC_OK;
 }
 
-wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
-                               const int32_t *particles, int32_t count, const wc_particle_arrays *p,
-                               int32_t steps_left, uint8_t *mark, int threads)
+static int32_t neighbour(const wc_cloth_elements *el, int32_t i, int32_t k);
+static void recount_local_steps(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                                const int32_t *particles, int32_t count, const wc_particle_arrays *p,
+                                int32_t *uncovered);
+
+/* One round of wci_candidates_rebase: the particles rebased, their lists and
+ * those of their triangles and edges made again, and the local steps near
+ * them recounted. Returns how many particles that recount pushed out of
+ * their cover, listed at c->again + n (n the particle count). 0 or -1 on
+ * out-of-memory. */
+static int32_t rebase_round(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                            const int32_t *particles, int32_t count, const wc_particle_arrays *p,
+                            int32_t steps_left, uint8_t *mark, int threads, int worst)
 {
     /* at most each particle and each of its triangles and edges once */
     int64_t most = count;
@@ -579,11 +629,8 @@ wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, c
         most += el->triangles_start[i + 1] - el->triangles_start[i];
         most += el->edges_start[i + 1] - el->edges_start[i];
     }
-    if (most > INT32_MAX || !ready_jobs(c, most, threads)) {
-        c->r = 0.0;
-        return WC_ERROR_OUT_OF_MEMORY;
-    }
-    for (int32_t k = 0; k < count; ++k) rebase_one(c, col, particles[k], p, steps_left);
+    if (most > INT32_MAX || !ready_jobs(c, most, threads)) return -1;
+    for (int32_t k = 0; k < count; ++k) rebase_one(c, col, particles[k], p, steps_left, worst);
     int32_t jobs = 0;
     for (int32_t k = 0; k < count; ++k) add_job(c, &jobs, LIST_PARTICLE, particles[k]);
     /* each triangle and edge of a rebased particle once, in the order met */
@@ -600,12 +647,32 @@ wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, c
         for (int32_t k = 0; k < count; ++k)
             for (int32_t j = start[particles[k]]; j < start[particles[k] + 1]; ++j) mark[items[j]] = 0;
     }
-    if (!make_lists(c, el, col, jobs, threads)) {
-        c->r = 0.0;
-        return WC_ERROR_OUT_OF_MEMORY;
-    }
+    if (!make_lists(c, el, col, jobs, threads)) return -1;
     /* new bases and margins: their reaches and their neighbours' */
-    wci_candidates_local_motion(c, el, col, particles, count);
+    int32_t uncovered = 0;
+    recount_local_steps(c, el, col, particles, count, p, &uncovered);
+    return uncovered;
+}
+
+wc_status wci_candidates_rebase(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                               const int32_t *particles, int32_t count, const wc_particle_arrays *p,
+                               int32_t steps_left, uint8_t *mark, int threads)
+{
+    /* A particle whose local step the recount raised past its cover is
+     * rebased in a further round, with a margin that covers the most any
+     * local step can be, so that no round rebases it again and the rounds
+     * end (each particle at most twice). */
+    int32_t n = el->particle_count, *work = c->again;
+    for (int worst = 0; count > 0; worst = 1) {
+        int32_t uncovered = rebase_round(c, el, col, particles, count, p, steps_left, mark, threads, worst);
+        if (uncovered < 0) {
+            c->r = 0.0;
+            return WC_ERROR_OUT_OF_MEMORY;
+        }
+        memcpy(work, c->again + n, (size_t)uncovered * sizeof *work);
+        for (int32_t k = 0; k < uncovered; ++k) c->particle_mark[work[k]] = 0;
+        particles = work, count = uncovered;
+    }
     return WC_OK;
 }
 
@@ -616,8 +683,12 @@ static int32_t neighbour(const wc_cloth_elements *el, int32_t i, int32_t k)
     return e[0] == i ? e[1] : e[0];
 }
 
-/* The half-side of particle i's cube (wci_candidates_local_motion). */
-static double local_reach(const wc_candidates *c, const wc_cloth_elements *el, int32_t i)
+/* The half-side of particle i's cube (wci_candidates_local_motion): what a
+ * collider triangle must be within to be near it. Besides the reach of its
+ * elements at their bases, the bases themselves move with their frames
+ * during the step, each by at most sqrt(3) S (LOCAL_STEP_MOST). */
+static double local_reach(const wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                          int32_t i)
 {
     double margin = c->margin[i], far2 = 0.0, b[3], q[3];
     base_of(c, i, b);
@@ -629,52 +700,129 @@ static double local_reach(const wc_candidates *c, const wc_cloth_elements *el, i
         double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if (d2 > far2) far2 = d2;
     }
-    return c->r + margin + sqrt(far2);
+    return c->r + margin + sqrt(far2) + 2.0 * col->step_motion;
 }
 
-static void local_motion_of(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
-                            int32_t i)
+/* Particle i's own step: how far, at most, the collider's triangles near it
+ * moved in this step relative to its frame's step. `choose` sets the
+ * frame's step first, to the centre of the box of their displacements (a
+ * collider carrying the cloth along then moves by about nothing relative
+ * to it); otherwise the frame's step stays as chosen at the start of the
+ * step, since snapshots taken since count from it. */
+static void own_step_of(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col, int32_t i,
+                        int choose)
 {
+    double *u = c->frame_step + 3 * (size_t)i;
     if (!(col->step_motion > 0.0) || c->whole_collider) {
-        c->local_step[i] = col->step_motion;
+        c->own_step[i] = col->step_motion;
+        if (choose) u[0] = u[1] = u[2] = 0.0;
         return;
     }
-    double b[3], reach = local_reach(c, el, i), box[6];
+    double b[3], reach = local_reach(c, el, col, i), box[6], shift[6];
     base_of(c, i, b);
     for (int k = 0; k < 3; ++k) box[k] = b[k] - reach, box[k + 3] = b[k] + reach;
-    c->local_step[i] = wci_bvh_most_within(&col->bvh, col->triangle_motion, col->node_motion, box);
-}
-
-void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el,
-                                 const wc_collider *col, const int32_t *particles, int32_t count)
-{
-    if (!particles) {
-        for (int32_t i = 0; i < el->particle_count; ++i) local_motion_of(c, el, col, i);
+    if (!wci_bvh_union_within(&col->bvh, col->triangle_shift, col->node_shift, box, shift)) {
+        if (choose) u[0] = u[1] = u[2] = 0.0;
+        c->own_step[i] = 0.0;
         return;
     }
+    if (choose) {
+        for (int k = 0; k < 3; ++k) u[k] = 0.5 * (shift[k] + shift[k + 3]);
+        if (u[0] != 0.0 || u[1] != 0.0 || u[2] != 0.0) c->framed = 1;
+    }
+    /* the farthest corner of the box from the frame's step */
+    double far2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        double lo = u[k] - shift[k], hi = shift[k + 3] - u[k], g = lo > hi ? lo : hi;
+        far2 += g * g;
+    }
+    c->own_step[i] = sqrt(far2);
+}
+
+void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col)
+{
+    if (!(col->step_motion > 0.0) || c->whole_collider) {
+        /* every frame stands still this step, and every step is the same */
+        for (int32_t i = 0; i < el->particle_count; ++i) own_step_of(c, el, col, i, 1);
+        for (int32_t i = 0; i < el->particle_count; ++i) c->local_step[i] = c->own_step[i];
+        return;
+    }
+    for (int32_t i = 0; i < el->particle_count; ++i) own_step_of(c, el, col, i, 1);
+    /* an element's pairs move relative to its particles' frames by no more
+     * than the largest of their own steps (candidates.h, relative motion),
+     * and every element of i has only i and its neighbours */
+    for (int32_t i = 0; i < el->particle_count; ++i) {
+        double most = c->own_step[i];
+        for (int32_t m = el->edges_start[i]; m < el->edges_start[i + 1]; ++m)
+            if (c->own_step[neighbour(el, i, m)] > most) most = c->own_step[neighbour(el, i, m)];
+        c->local_step[i] = most;
+    }
+}
+
+/* Particle j's own step taken into its local step and its neighbours'
+ * (raised, never lowered: within a step a local step only grows); a
+ * particle whose cover that breaks is listed at c->again + n. */
+static void raise_local_steps(wc_candidates *c, const wc_cloth_elements *el, int32_t j,
+                              const wc_particle_arrays *p, int32_t *uncovered)
+{
+    int32_t n = el->particle_count;
+    for (int32_t m = el->edges_start[j] - 1; m < el->edges_start[j + 1]; ++m) {
+        int32_t k = m < el->edges_start[j] ? j : neighbour(el, j, m);
+        if (!(c->own_step[j] > c->local_step[k])) continue;
+        c->local_step[k] = c->own_step[j];
+        if (c->particle_mark[k] & 2 || wc_candidates_covers(c, k, wci_candidates_displacement(c, p, k)))
+            continue;
+        c->particle_mark[k] |= 2;
+        c->again[n + (*uncovered)++] = k;
+    }
+}
+
+/* After a rebase of the particles listed: the own steps of each and of each
+ * neighbour (their cubes take its base and margin) counted again, and the
+ * local steps near them raised to match. */
+static void recount_local_steps(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                                const int32_t *particles, int32_t count, const wc_particle_arrays *p,
+                                int32_t *uncovered)
+{
     /* each listed particle and each neighbour once, in the order met (m =
      * the start less one stands for the particle itself) */
-    for (int32_t k = 0; k < count; ++k) {
-        int32_t i = particles[k];
-        for (int32_t m = el->edges_start[i] - 1; m < el->edges_start[i + 1]; ++m) {
-            int32_t j = m < el->edges_start[i] ? i : neighbour(el, i, m);
-            if (c->particle_mark[j]) continue;
-            c->particle_mark[j] = 1;
-            local_motion_of(c, el, col, j);
+    for (int pass = 0; pass < 2; ++pass) {
+        for (int32_t k = 0; k < count; ++k) {
+            int32_t i = particles[k];
+            for (int32_t m = el->edges_start[i] - 1; m < el->edges_start[i + 1]; ++m) {
+                int32_t j = m < el->edges_start[i] ? i : neighbour(el, i, m);
+                if (c->particle_mark[j] & 1) continue;
+                c->particle_mark[j] |= 1;
+                if (pass == 0) own_step_of(c, el, col, j, 0);
+                else raise_local_steps(c, el, j, p, uncovered);
+            }
         }
-    }
-    for (int32_t k = 0; k < count; ++k) {
-        int32_t i = particles[k];
-        c->particle_mark[i] = 0;
-        for (int32_t m = el->edges_start[i]; m < el->edges_start[i + 1]; ++m)
-            c->particle_mark[neighbour(el, i, m)] = 0;
+        for (int32_t k = 0; k < count; ++k) {
+            int32_t i = particles[k];
+            c->particle_mark[i] &= (uint8_t)~1u;
+            for (int32_t m = el->edges_start[i]; m < el->edges_start[i + 1]; ++m)
+                c->particle_mark[neighbour(el, i, m)] &= (uint8_t)~1u;
+        }
     }
 }
 
 void wci_candidates_commit(wc_candidates *c, int32_t particle_count)
 {
     if (!c->local_path) return;
-    for (int32_t i = 0; i < particle_count; ++i) c->local_path[i] += c->local_step[i], c->local_step[i] = 0.0;
+    for (int32_t i = 0; i < particle_count; ++i) {
+        c->local_path[i] += c->local_step[i], c->local_step[i] = 0.0;
+        for (int k = 0; k < 3 && c->framed; ++k) {
+            c->frame[3 * (size_t)i + k] += c->frame_step[3 * (size_t)i + k];
+            c->frame_step[3 * (size_t)i + k] = 0.0;
+        }
+    }
+}
+
+/* Particle i's end less its frame's end: where it is in its frame. */
+static void end_in_frame(const wc_candidates *c, const wc_particle_arrays *p, int32_t i, double out[3])
+{
+    frame_of(c, i, 1, out);
+    out[0] = p->nx[i] - out[0], out[1] = p->ny[i] - out[1], out[2] = p->nz[i] - out[2];
 }
 
 double wci_candidates_ceiling(const wc_candidates *c, double r, const int32_t *idx, int count,
@@ -684,56 +832,65 @@ double wci_candidates_ceiling(const wc_candidates *c, double r, const int32_t *i
     for (int k = 0; k < count; ++k) {
         int32_t i = idx[k];
         const double *b = c->base + 3 * (size_t)i;
-        double d[3] = {p->nx[i] - b[0], p->ny[i] - b[1], p->nz[i] - b[2]};
+        double e[3];
+        end_in_frame(c, p, i, e);
+        double d[3] = {e[0] - b[0], e[1] - b[1], e[2] - b[2]};
         double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if (d2 > far2) far2 = d2;
     }
     return r + element_margin(c, idx, count) - sqrt(far2);
 }
 
-/* The larger distance of particle i at the start and at the end of the
- * step from a point: by convexity, the most it is from it over the step. */
-static double farthest_over_step(const wc_particle_arrays *p, int32_t i, const double at[3])
+/* The larger distance of particle i in its frame at the start and at the
+ * end of the step from a point of its frame: by convexity (the particle
+ * and its frame both move linearly in the step), the most it is from it
+ * over the step. */
+static double farthest_over_step(const wc_candidates *c, const wc_particle_arrays *p, int32_t i,
+                                 const double at[3])
 {
-    double s[3] = {p->x[i] - at[0], p->y[i] - at[1], p->z[i] - at[2]};
-    double e[3] = {p->nx[i] - at[0], p->ny[i] - at[1], p->nz[i] - at[2]};
-    double s2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2], e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+    double f[3], e[3];
+    frame_of(c, i, 0, f);
+    end_in_frame(c, p, i, e);
+    double s[3] = {p->x[i] - f[0] - at[0], p->y[i] - f[1] - at[1], p->z[i] - f[2] - at[2]};
+    double t[3] = {e[0] - at[0], e[1] - at[1], e[2] - at[2]};
+    double s2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2], e2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
     return sqrt(s2 > e2 ? s2 : e2);
 }
 
 double wci_candidates_displacement(const wc_candidates *c, const wc_particle_arrays *p, int32_t i)
 {
-    return farthest_over_step(p, i, c->base + 3 * (size_t)i);
+    return farthest_over_step(c, p, i, c->base + 3 * (size_t)i);
 }
 
-double wci_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
-                           const wc_particle_arrays *p)
+double wci_pair_lists_drift(const wc_candidates *c, const wc_pair_lists *l, int32_t k,
+                           const int32_t *particles, const wc_particle_arrays *p)
 {
     const double *snap = l->snap + 3 * (size_t)l->per * (size_t)k;
     double most = 0.0;
     for (int j = 0; j < l->per; ++j) {
-        double d = farthest_over_step(p, particles[j], snap + 3 * j);
+        double d = farthest_over_step(c, p, particles[j], snap + 3 * j);
         if (d > most) most = d;
     }
     return most;
 }
 
-double wci_pair_lists_end_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
-                               const wc_particle_arrays *p)
+double wci_pair_lists_end_drift(const wc_candidates *c, const wc_pair_lists *l, int32_t k,
+                               const int32_t *particles, const wc_particle_arrays *p)
 {
     const double *snap = l->snap + 3 * (size_t)l->per * (size_t)k;
     double most2 = 0.0;
     for (int j = 0; j < l->per; ++j) {
-        int32_t i = particles[j];
         const double *at = snap + 3 * j;
-        double e[3] = {p->nx[i] - at[0], p->ny[i] - at[1], p->nz[i] - at[2]};
-        double e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-        if (e2 > most2) most2 = e2;
+        double e[3];
+        end_in_frame(c, p, particles[j], e);
+        double d[3] = {e[0] - at[0], e[1] - at[1], e[2] - at[2]};
+        double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        if (d2 > most2) most2 = d2;
     }
     return sqrt(most2);
 }
 
-void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
+void wci_pair_lists_renew(const wc_candidates *c, wc_pair_lists *l, int32_t k, const int32_t *particles,
                          const wc_particle_arrays *p, double collider_path, const int32_t *at,
                          const double *measured2, int32_t n, double least_unmeasured,
                          double drift_end, double ceiling)
@@ -748,8 +905,5 @@ void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
     l->least[k] = least;
     l->path_at[k] = collider_path;
     double *snap = l->snap + 3 * (size_t)l->per * (size_t)k;
-    for (int j = 0; j < l->per; ++j) {
-        int32_t i = particles[j];
-        snap[3 * j] = p->nx[i], snap[3 * j + 1] = p->ny[i], snap[3 * j + 2] = p->nz[i];
-    }
+    for (int j = 0; j < l->per; ++j) end_in_frame(c, p, particles[j], snap + 3 * j);
 }

@@ -64,6 +64,30 @@
  * a branch and bound over the collider's tree (broadphase.h); a still
  * collider costs nothing. A rebase changes bases and margins, so it makes
  * the local steps of the rebased particles and their neighbours again.
+ *
+ * Relative motion. A collider that carries the cloth along (a character
+ * walking, a tube bending under a cloth that rides it) moves it as far as it
+ * moves itself, and a bound that adds the two used a particle's margin in a
+ * few steps. So each particle has a frame: a translation that follows the
+ * collider near it, its step chosen at the start of each step as the
+ * centre of the box of the displacements of the collider's triangles near
+ * the particle. Everything above is measured in the particles' frames: a
+ * base or a snapshot is a position less the frame's at that time, D_p is
+ * how far the particle moved in its frame, and a particle's own step is the
+ * farthest any near triangle's corner moved from its frame's step (0 for a
+ * collider that only translates). Why that holds: a frame's translation
+ * moves a point and its base alike, so distances in a frame are distances;
+ * for a pair of an element with particles p_k (own frames U_k) and a
+ * feature with vertices q_j, the point p = sum w_k p_k and the feature's
+ * point q = sum v_j q_j change by sum_k w_k (dp_k - dU_k) + sum_k w_k dU_k -
+ * sum_j v_j dq_j, whose norm is at most max_k |dp_k - dU_k| + max_k max_j
+ * |dq_j - dU_k|: the particles' motion in their frames plus the largest of
+ * their own steps. A particle's local step is therefore the largest own
+ * step of it and its neighbours (an element has only those), and the rest
+ * of the argument is unchanged, with each cube grown by how far the frames
+ * of its particles can move in the step. A frame's step, once chosen, stays
+ * for the step: a rebase recounts its neighbours' own steps against it, and
+ * a local step that rises past a particle's cover rebases that particle too.
  */
 #ifndef WC_CANDIDATES_H
 #define WC_CANDIDATES_H
@@ -133,8 +157,19 @@ typedef struct wc_candidates {
     double *local_path, *local_step;
     /// Scratch per particle (zero between calls).
     uint8_t *particle_mark;
+    /// Per particle: its frame, the translations summed over the committed
+    /// steps, and this step's (xyz each; see relative motion above), and its
+    /// own step (the local step before its neighbours' are taken in).
+    double *frame, *frame_step, *own_step;
+    /// Whether any frame has moved: until one does (a collider that stands
+    /// still), every frame is 0 and is not read.
+    int framed;
+    /// Scratch: the particles a rebase's recount pushed out of their cover
+    /// (twice the particle count).
+    int32_t *again;
     /// A test's switch: every particle's local motion is the collider's
-    /// largest (its step motion), as if the whole collider were near.
+    /// largest (its step motion), as if the whole collider were near, and
+    /// its frame stands still.
     int whole_collider;
     wc_pair_lists particles, triangles, edges;
     /// The lists being made (candidates.c, making lists): one maker of
@@ -189,17 +224,19 @@ static inline int wc_candidates_rebase_due(const wc_candidates *cand, int32_t i,
     return d + (wc_candidates_path_now(cand, i) - cand->base_path[i]) >= WC_REBASE_AHEAD * cand->margin[i];
 }
 
-/// This step's local motion (local_step) of the `count` particles listed,
-/// or of every particle when `particles` is NULL, and of their neighbours
-/// (a particle's reach takes its neighbours' margins and bases): the
-/// largest displacement in this step of the collider's triangles whose
-/// boxes meet the cube of half-side r + (the largest margin of the particle
-/// and its neighbours) + (its farthest neighbour's distance) around its
-/// base. 0 for a collider that stands still.
+/// This step's frame steps and local steps of every particle (see local
+/// and relative motion above): the collider's triangles near particle i are
+/// those whose boxes meet the cube of half-side r + (the largest margin of i
+/// and its neighbours) + (its farthest neighbour's distance) + 2 S around
+/// its base (S the collider's step motion); its frame's step is the centre
+/// of the box of their displacements, its own step the farthest of them
+/// from it, and its local step the largest own step of it and its
+/// neighbours. 0 for a collider that stands still.
 void wci_candidates_local_motion(wc_candidates *cand, const wc_cloth_elements *el,
-                                 const wc_collider *col, const int32_t *particles, int32_t count);
+                                 const wc_collider *col);
 
-/// After a committed step: every particle's local step added to its path.
+/// After a committed step: every particle's local step added to its path
+/// and its frame's step to its frame.
 void wci_candidates_commit(wc_candidates *cand, int32_t particle_count);
 
 /// The most a renewed snapshot of the owner with particles idx[0 .. count)
@@ -210,8 +247,9 @@ void wci_candidates_commit(wc_candidates *cand, int32_t particle_count);
 double wci_candidates_ceiling(const wc_candidates *cand, double r, const int32_t *idx, int count,
                               const wc_particle_arrays *p);
 
-/// Particle i's distance from its base: the larger at the start (x) and at
-/// the end (nx) of the step, which by convexity bounds it over the step.
+/// Particle i's distance from its base in its frame: the larger at the
+/// start (x) and at the end (nx) of the step, which by convexity bounds it
+/// over the step.
 double wci_candidates_displacement(const wc_candidates *cand, const wc_particle_arrays *p, int32_t i);
 
 /// Makes every list (first use, or the contact distance changed), with
@@ -225,7 +263,8 @@ wc_status wci_candidates_update(wc_candidates *cand, const wc_cloth_elements *el
 
 /// Rebases the `count` particles listed (new base at their start-of-step
 /// position and a new margin) and makes their lists and those of their
-/// triangles and edges again. `mark` is per-element scratch (zero, left
+/// triangles and edges again; a neighbour whose local step that raises past
+/// its cover is rebased too. `mark` is per-element scratch (zero, left
 /// zero), sized for the larger of the cloth's triangle and edge counts.
 wc_status wci_candidates_rebase(wc_candidates *cand, const wc_cloth_elements *el,
                                const wc_collider *col, const int32_t *particles, int32_t count,
@@ -233,14 +272,14 @@ wc_status wci_candidates_rebase(wc_candidates *cand, const wc_cloth_elements *el
                                int threads);
 
 /// How far owner k's particles can be from where they were at its
-/// snapshot, over the step (starts and ends).
-double wci_pair_lists_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
-                           const wc_particle_arrays *p);
+/// snapshot, over the step (starts and ends), each in its frame.
+double wci_pair_lists_drift(const wc_candidates *cand, const wc_pair_lists *l, int32_t k,
+                           const int32_t *particles, const wc_particle_arrays *p);
 
 /// How far owner k's particles' ends are from where they were at its
-/// snapshot.
-double wci_pair_lists_end_drift(const wc_pair_lists *l, int32_t k, const int32_t *particles,
-                               const wc_particle_arrays *p);
+/// snapshot, each in its frame.
+double wci_pair_lists_end_drift(const wc_candidates *cand, const wc_pair_lists *l, int32_t k,
+                               const int32_t *particles, const wc_particle_arrays *p);
 
 /// After a visit of owner k that moved nothing: its snapshot renewed at its
 /// particles' present ends and the collider's end of step. The items at
@@ -250,7 +289,7 @@ double wci_pair_lists_end_drift(const wc_pair_lists *l, int32_t k, const int32_t
 /// have moved from the old snapshot to now), and the least of their d is
 /// `least_unmeasured` (INFINITY if none). `collider_path` is the local path
 /// that the owner's drift is measured against, now.
-void wci_pair_lists_renew(wc_pair_lists *l, int32_t k, const int32_t *particles,
+void wci_pair_lists_renew(const wc_candidates *cand, wc_pair_lists *l, int32_t k, const int32_t *particles,
                          const wc_particle_arrays *p, double collider_path, const int32_t *at,
                          const double *measured2, int32_t n, double least_unmeasured,
                          double drift_end, double ceiling);

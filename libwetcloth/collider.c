@@ -49,9 +49,8 @@ void wci_collider_destroy(wc_collider *c)
     wci_free(c->vertex_boxes);
     wci_free(c->used_vertices);
     wci_free(c->normals);
-    wci_free(c->vertex_motion);
-    wci_free(c->triangle_motion);
-    wci_free(c->node_motion);
+    wci_free(c->triangle_shift);
+    wci_free(c->node_shift);
     wci_bvh_destroy(&c->bvh);
     wci_bvh_destroy(&c->edge_bvh);
     wci_bvh_destroy(&c->vertex_bvh);
@@ -381,31 +380,35 @@ static void static_normals(wc_collider *c)
     c->normals_current = 1;
 }
 
-/* This step's displacement per vertex, per triangle and per node of the
- * tree (the tree's boxes span the advance, so they hold the step's), and
- * the largest of all: the step motion. */
+/* This step's displacements: the box of its corners' per triangle and the
+ * union of those per node of the tree (the tree's boxes span the advance,
+ * so they hold the step's), and the largest displacement of any vertex:
+ * the step motion. */
 static wc_status step_motions(wc_collider *c)
 {
-    if (!c->vertex_motion) c->vertex_motion = wci_alloc_array((size_t)c->vertex_count + 1, sizeof(double));
-    if (!c->triangle_motion) c->triangle_motion = wci_alloc_array((size_t)c->triangle_count + 1, sizeof(double));
-    if (!c->node_motion) c->node_motion = wci_alloc_array(2 * (size_t)c->triangle_count + 1, sizeof(double));
-    if (!c->vertex_motion || !c->triangle_motion || !c->node_motion) return WC_ERROR_OUT_OF_MEMORY;
-    double most = 0.0;
+    if (!c->triangle_shift) c->triangle_shift = wci_alloc_array(6 * ((size_t)c->triangle_count + 1), sizeof(double));
+    if (!c->node_shift) c->node_shift = wci_alloc_array(6 * (2 * (size_t)c->triangle_count + 1), sizeof(double));
+    if (!c->triangle_shift || !c->node_shift) return WC_ERROR_OUT_OF_MEMORY;
+    double most2 = 0.0;
     for (int32_t v = 0; v < c->vertex_count; ++v) {
         const double *a = c->current + 3 * (size_t)v, *b = c->next + 3 * (size_t)v;
         double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-        c->vertex_motion[v] = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        if (c->vertex_motion[v] > most) most = c->vertex_motion[v];
+        double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        if (d2 > most2) most2 = d2;
     }
     for (int32_t t = 0; t < c->triangle_count; ++t) {
         const int32_t *v = c->triangles + 3 * (size_t)t;
-        double m = c->vertex_motion[v[0]];
-        if (c->vertex_motion[v[1]] > m) m = c->vertex_motion[v[1]];
-        if (c->vertex_motion[v[2]] > m) m = c->vertex_motion[v[2]];
-        c->triangle_motion[t] = m;
+        double *box = c->triangle_shift + 6 * (size_t)t;
+        for (int k = 0; k < 3; ++k) box[k] = INFINITY, box[k + 3] = -INFINITY;
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) {
+                double d = c->next[3 * (size_t)v[j] + k] - c->current[3 * (size_t)v[j] + k];
+                if (d < box[k]) box[k] = d;
+                if (d > box[k + 3]) box[k + 3] = d;
+            }
     }
-    wci_bvh_fold_max(&c->bvh, c->triangle_motion, c->node_motion);
-    c->step_motion = most;
+    wci_bvh_fold_boxes(&c->bvh, c->triangle_shift, c->node_shift);
+    c->step_motion = sqrt(most2);
     return WC_OK;
 }
 

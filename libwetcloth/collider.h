@@ -86,12 +86,13 @@ typedef struct wc_collider {
     /// in the step being computed. No vertex has moved farther than the
     /// difference of two paths between them (candidates.h).
     double path, step_motion;
-    /// While moving, this step's displacement of each vertex, the largest
-    /// of its corners' per triangle, and the largest of its triangles' per
-    /// node of the tree (wci_bvh_fold_max): what the candidates read to
-    /// bound the collider's motion near each cloth particle rather than
-    /// anywhere (candidates.h). Made at the first step that moves it.
-    double *vertex_motion, *triangle_motion, *node_motion;
+    /// While moving, the box (min xyz, max xyz) of this step's
+    /// displacements of each triangle's corners, and the union of its
+    /// triangles' per node of the tree (wci_bvh_fold_boxes): what the
+    /// candidates read to bound the collider's motion near each cloth
+    /// particle, relative to a translation that follows it (candidates.h).
+    /// Made at the first step that moves it.
+    double *triangle_shift, *node_shift;
 
     /* Convex colliders. */
     wc_convex_shape convex;

@@ -264,9 +264,9 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         if (cand->r != r) {
             if (wci_candidates_update(cand, &s->el, col, r, p, steps_left, threads))
                 return WC_ERROR_OUT_OF_MEMORY;
-            continue;
+        } else {
+            wci_candidates_local_motion(cand, &s->el, col);
         }
-        wci_candidates_local_motion(cand, &s->el, col, NULL, c->particle_count);
         for (int32_t i = 0; i < c->particle_count; ++i)
             if (wc_candidates_rebase_due(cand, i, wci_candidates_displacement(cand, p, i)))
                 note_rebase(s, i);
@@ -459,10 +459,10 @@ static void renew_particle(const wc_candidates *cand, const wc_particle_arrays *
         }
     }
     double now = wc_candidates_path_now(cand, i), step = cand->local_step[i];
-    double end_drift = wci_pair_lists_end_drift(l, i, &i, p) + (now - l->path_at[i]);
+    double end_drift = wci_pair_lists_end_drift(cand, l, i, &i, p) + (now - l->path_at[i]);
     /* the collider counted from before this step, which may yet be refused
      * and taken again (as in visit_element) */
-    wci_pair_lists_renew(l, i, &i, p, now - 2.0 * step, m->at, m->d2, m->n, m->rest, end_drift,
+    wci_pair_lists_renew(cand, l, i, &i, p, now - 2.0 * step, m->at, m->d2, m->n, m->rest, end_drift,
                         wci_candidates_ceiling(cand, cand->r, &i, 1, p));
 }
 
@@ -502,7 +502,7 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
             if (kept != stack) wci_free(kept);
             kept = grown, room = l->count[i];
         }
-        double near = wci_pair_lists_drift(l, i, &i, p);
+        double near = wci_pair_lists_drift(cand, l, i, &i, p);
         double reach = r + near + drift + l->debt[i] + FILTER_EPSILON(r), rest;
         /* nothing in the list can touch (the hanging part of a draped
          * cloth): no scan, and the old snapshot kept, whose bound is the
@@ -691,7 +691,7 @@ static int feature_scratch(wc_collider_contacts *s, int32_t n)
 static double element_drift(const wc_candidates *cand, const wc_pair_lists *l, int32_t e,
                             const int32_t *idx, const wc_particle_arrays *p)
 {
-    return wci_pair_lists_drift(l, e, idx, p) + (wc_candidates_path_now(cand, idx[0]) - l->path_at[e]);
+    return wci_pair_lists_drift(cand, l, e, idx, p) + (wc_candidates_path_now(cand, idx[0]) - l->path_at[e]);
 }
 
 /* Element e against the collider features its list keeps through the
@@ -751,13 +751,13 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
          * a fresh snapshot. (After a push the list may have been made again,
          * and what was measured before the push is of no use.) */
         double now = wc_candidates_path_now(cand, idx[0]), step = cand->local_step[idx[0]];
-        double end_drift = wci_pair_lists_end_drift(l, e, idx, p) + (now - l->path_at[e]);
+        double end_drift = wci_pair_lists_end_drift(cand, l, e, idx, p) + (now - l->path_at[e]);
         /* The snapshot's collider is where this step takes it, and the step
          * may yet be refused (a failed or tearing step) and taken again:
          * counted from the committed path less this step's motion, the
          * drift covers the collider from there as well as from where it
          * really goes. */
-        wci_pair_lists_renew((wc_pair_lists *)l, e, idx, p, now - 2.0 * step, s->kept, s->measured, n, rest,
+        wci_pair_lists_renew(cand, (wc_pair_lists *)l, e, idx, p, now - 2.0 * step, s->kept, s->measured, n, rest,
                             end_drift, wci_candidates_ceiling(cand, cand->feature_r, idx, kind->count, p));
     }
     return pushed;

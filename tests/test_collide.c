@@ -761,8 +761,10 @@ static void rest_on_a_pole(void)
  * each particle by the triangles near it (candidates.h, local motion), not
  * by the fastest vertex anywhere. `flap` (m) lifts and lowers the ground's
  * far strip (x > 0.55) by up to that much a frame, far from the cloth;
- * `bump` (m) raises a smooth bump under the cloth's middle over the run.
- * `local` 0 counts the ground's largest motion near every particle; `filter`
+ * `bump` (m) raises a smooth bump under the cloth's middle over the run;
+ * `rise` (m) lifts the whole ground by that much a frame, carrying the
+ * cloth up. `local` 0 counts the ground's largest motion near every
+ * particle, with frames that stand still (candidates.h); `filter`
  * 0 gives every listed pair the exact test; `refuse` 1 makes every step
  * count as tearing, so each is refused and taken again as halves down to
  * the last halving. Returns the feature tests of the last 12 frames and the
@@ -771,16 +773,16 @@ enum { GROUND_N = 48 };
 
 typedef struct ground_run {
     int local, filter, refuse;
-    double flap, bump;
+    double flap, bump, rise;
 } ground_run;
 
-static void ground_vertices(double flap, double bump, double *v)
+static void ground_vertices(double flap, double bump, double rise, double *v)
 {
     for (int j = 0; j <= GROUND_N; ++j)
         for (int i = 0; i <= GROUND_N; ++i) {
             double x = -0.8 + 1.6 * i / GROUND_N, y = -0.8 + 1.6 * j / GROUND_N;
             double z = x > 0.55 ? flap * (x - 0.55) / 0.25 : 0.0;
-            z += bump * exp(-(x * x + y * y) / (2 * 0.1 * 0.1));
+            z += bump * exp(-(x * x + y * y) / (2 * 0.1 * 0.1)) + rise;
             double *p = v + 3 * (size_t)(j * (GROUND_N + 1) + i);
             p[0] = x, p[1] = y, p[2] = z;
         }
@@ -800,7 +802,7 @@ static int64_t deforming_ground(ground_run run, uint64_t *hash)
     wc_world_def def = wc_world_def_default();
     def.thread_count = 1;
     wc_world *w = scene_world_from(&def);
-    ground_vertices(0.0, 0.0, v);
+    ground_vertices(0.0, 0.0, 0.0, v);
     wc_mesh_collider_def d = wc_mesh_collider_def_default();
     d.vertices = v, d.vertex_count = (GROUND_N + 1) * (GROUND_N + 1);
     d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
@@ -816,7 +818,7 @@ static int64_t deforming_ground(ground_run run, uint64_t *hash)
     for (int f = 0; f < 36; ++f) {
         if (f >= 12) {
             double s = (f - 11) / 24.0;
-            ground_vertices(run.flap * sin(3.0 * (f - 11)), run.bump * s, v);
+            ground_vertices(run.flap * sin(3.0 * (f - 11)), run.bump * s, run.rise * (f - 11), v);
             CHECK(wc_collider_set_vertices(w, col, v, d.vertex_count) == WC_OK, "%s",
                   wc_world_last_error(w));
         }
@@ -843,11 +845,11 @@ static int64_t deforming_ground(ground_run run, uint64_t *hash)
 static void local_collider_motion(void)
 {
     uint64_t local_hash, whole_hash, still_hash, flap_hash, flap_whole_hash;
-    deforming_ground((ground_run){1, 1, 0, 0.05, 0.04}, &local_hash);
-    deforming_ground((ground_run){0, 1, 0, 0.05, 0.04}, &whole_hash);
-    int64_t still = deforming_ground((ground_run){1, 1, 0, 0.0, 0.0}, &still_hash);
-    int64_t flap = deforming_ground((ground_run){1, 1, 0, 0.05, 0.0}, &flap_hash);
-    int64_t flap_whole = deforming_ground((ground_run){0, 1, 0, 0.05, 0.0}, &flap_whole_hash);
+    deforming_ground((ground_run){1, 1, 0, 0.05, 0.04, 0.0}, &local_hash);
+    deforming_ground((ground_run){0, 1, 0, 0.05, 0.04, 0.0}, &whole_hash);
+    int64_t still = deforming_ground((ground_run){1, 1, 0, 0.0, 0.0, 0.0}, &still_hash);
+    int64_t flap = deforming_ground((ground_run){1, 1, 0, 0.05, 0.0, 0.0}, &flap_hash);
+    int64_t flap_whole = deforming_ground((ground_run){0, 1, 0, 0.05, 0.0, 0.0}, &flap_whole_hash);
     printf("deforming ground: bump %016llx (local) %016llx (whole); resting, frames 25-36: %lld "
            "feature tests on a still ground, %lld with the far strip flapping, %lld with its "
            "motion counted everywhere\n", (unsigned long long)local_hash,
@@ -860,6 +862,35 @@ static void local_collider_motion(void)
           (long long)flap, (long long)still, (long long)flap_whole);
 }
 
+/* A ground that rises 1 cm a frame carries the resting cloth up with it.
+ * Counted in frames that follow the ground (candidates.h, relative motion),
+ * the cloth barely moves relative to it, and the lift costs it few feature
+ * tests; counted as motion, both the ground's and the cloth's, it rebases
+ * every particle every few steps and tests their pairs. The same bits
+ * either way, and the same as with every listed pair tested; with the
+ * ground also bumping and flapping, too. */
+static void ground_carrying_the_cloth(void)
+{
+    uint64_t framed_hash, whole_hash, all_hash, mixed_hash, mixed_all_hash;
+    int64_t framed = deforming_ground((ground_run){1, 1, 0, 0.0, 0.0, 0.01}, &framed_hash);
+    int64_t whole = deforming_ground((ground_run){0, 1, 0, 0.0, 0.0, 0.01}, &whole_hash);
+    deforming_ground((ground_run){1, 0, 0, 0.0, 0.0, 0.01}, &all_hash);
+    deforming_ground((ground_run){1, 1, 0, 0.05, 0.04, 0.01}, &mixed_hash);
+    deforming_ground((ground_run){1, 0, 0, 0.05, 0.04, 0.01}, &mixed_all_hash);
+    printf("rising ground: %016llx (frames) %016llx (motion counted) %016llx (every listed pair); "
+           "feature tests, frames 25-36: %lld in frames, %lld counted as motion; rising, bumping "
+           "and flapping: %016llx, every listed pair %016llx\n",
+           (unsigned long long)framed_hash, (unsigned long long)whole_hash, (unsigned long long)all_hash,
+           (long long)framed, (long long)whole, (unsigned long long)mixed_hash,
+           (unsigned long long)mixed_all_hash);
+    CHECK(framed_hash == whole_hash, "the frames changed the result on a rising ground");
+    CHECK(framed_hash == all_hash, "the filter changed the result on a rising ground");
+    CHECK(mixed_hash == mixed_all_hash, "the filter changed the result on a rising, bumping ground");
+    CHECK(whole > 0, "the rising ground's motion made no tests");
+    CHECK(20 * framed <= whole, "a ground carrying the cloth costs it tests in frames: %lld, %lld counted as motion",
+          (long long)framed, (long long)whole);
+}
+
 /* A snapshot renewed in a step that is then refused was taken with the
  * collider where that step would have put it, which the half steps never
  * reach: the filter must still only skip what cannot touch. With every
@@ -870,8 +901,8 @@ static void local_collider_motion(void)
 static void refused_steps_on_a_moving_ground(void)
 {
     uint64_t filtered, all;
-    deforming_ground((ground_run){1, 1, 1, 0.05, 0.15}, &filtered);
-    deforming_ground((ground_run){1, 0, 1, 0.05, 0.15}, &all);
+    deforming_ground((ground_run){1, 1, 1, 0.05, 0.15, 0.0}, &filtered);
+    deforming_ground((ground_run){1, 0, 1, 0.05, 0.15, 0.0}, &all);
     printf("moving ground, every step refused: filtered %016llx, every listed pair tested %016llx\n",
            (unsigned long long)filtered, (unsigned long long)all);
     CHECK(filtered == all, "the filter changed the result of refused steps on a moving ground");
@@ -913,6 +944,7 @@ int main(void)
     local_collider_motion();
     printf("(%.1f s) ", seconds() - t0);
     refused_steps_on_a_moving_ground();
+    ground_carrying_the_cloth();
     printf("(%.1f s)\n", seconds() - t0);
     return test_report("test_collide");
 }

@@ -32,7 +32,9 @@
  * adhesion, spread, wet_friction, wet_grip, damping (stretch damping; the cloth
  * material's, for experiments),
  * check (1: count intersections at the last frame; 2: at every frame),
- * bend (1: the cylinder's ends rise; 0: it stays straight), trace (1: one
+ * bend (1: the cylinder's ends rise; 0: it stays straight), carry (m/s, 0:
+ * from the middle frame of the run on, the collider moves along x at that
+ * speed, carrying the cloth that rests on it), trace (1: one
  * line per frame on stderr: wall and collide ms, longest link, fail-safe
  * particles, intersections when counted).
  *
@@ -59,7 +61,7 @@ typedef struct options {
     const char *scene;
     int frames, steps, threads, adapt, wet, self, size, check, steps_given, bend, trace;
     const char *integrator;
-    double thickness, friction, adhesion, spread, wet_friction, wet_grip, damping;
+    double thickness, friction, adhesion, spread, wet_friction, wet_grip, damping, carry;
     const char *out;
 } options;
 
@@ -181,6 +183,7 @@ static int parse(int argc, char **argv, options *o)
         else if (!strcmp(key, "size")) o->size = atoi(val);
         else if (!strcmp(key, "check")) o->check = atoi(val);
         else if (!strcmp(key, "bend")) o->bend = atoi(val);
+        else if (!strcmp(key, "carry")) o->carry = atof(val);
         else if (!strcmp(key, "trace")) o->trace = atoi(val);
         else if (!strcmp(key, "integrator")) o->integrator = val;
         else if (!strcmp(key, "thickness")) o->thickness = atof(val);
@@ -282,7 +285,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: bench_contacts scene=thesis|sphere64|sphere176|soaked|cylinder|"
                         "drape101 [frames=24] [integrator=default|verlet|xpbd|implicit] [steps=0] "
                         "[threads=1] [adapt=1] [wet=0] [self=0] [thickness=0.02] [friction=0.5] [size=N] "
-                        "[check=1] [bend=1] [trace=0] [out=FILE]\n");
+                        "[check=1] [bend=1] [carry=0] [trace=0] [out=FILE]\n");
         return 2;
     }
     scene s = make_scene(&o);
@@ -291,8 +294,8 @@ int main(int argc, char **argv)
     int32_t *pairs = checked_malloc(2 * (size_t)links * sizeof *pairs);
     double *rest = checked_malloc((size_t)links * sizeof *rest);
     double *xyz = checked_malloc(3 * (size_t)n * sizeof *xyz);
-    double *bent = s.deforming ? checked_malloc(3 * (size_t)s.collider_mesh.vertex_count * sizeof *bent)
-                               : NULL;
+    int moves = s.deforming || o.carry != 0.0;
+    double *bent = moves ? checked_malloc(3 * (size_t)s.collider_mesh.vertex_count * sizeof *bent) : NULL;
     bench_check(wc_cloth_get_links(s.world, s.cloth, WC_LINK_STRETCH, pairs, rest, links), s.world,
                 "links");
     uint8_t *contact = checked_malloc((size_t)n);
@@ -311,8 +314,12 @@ int main(int argc, char **argv)
      * struct (the commit before, run side by side): its count reads 0 */
     int has_halved = wc_struct_size("wc_step_stats") >= (int64_t)sizeof(wc_step_stats);
     for (int f = 0; f < o.frames; ++f) {
-        if (s.deforming) {
-            bend_tube(&s.collider_mesh, (double)(f + 1) / o.frames, bent);
+        if (moves) {
+            int32_t nv = s.collider_mesh.vertex_count;
+            if (s.deforming) bend_tube(&s.collider_mesh, (double)(f + 1) / o.frames, bent);
+            else memcpy(bent, s.collider_mesh.v, 3 * (size_t)nv * sizeof *bent);
+            double shift = f + 1 > o.frames / 2 ? o.carry * (f + 1 - o.frames / 2) / 24.0 : 0.0;
+            for (int32_t v = 0; v < nv; ++v) bent[3 * v] += shift;
             bench_check(wc_collider_set_vertices(s.world, s.collider, bent, s.collider_mesh.vertex_count),
                         s.world, "set vertices");
         }
