@@ -267,8 +267,14 @@ void wci_bvh_fold_boxes(const wc_bvh *b, const double *item_boxes, double *node_
     }
 }
 
+/* Whether every side of a box is at most `size`. */
+static int box_within_size(const double *box, double size)
+{
+    return box[3] - box[0] <= size && box[4] - box[1] <= size && box[5] - box[2] <= size;
+}
+
 int wci_bvh_union_within(const wc_bvh *b, const double *item_boxes, const double *node_boxes,
-                         const double box[6], double out[6])
+                         const double box[6], double whole_below, double out[6])
 {
     box_empty(out);
     if (b->node_count == 0) return 0;
@@ -279,8 +285,9 @@ int wci_bvh_union_within(const wc_bvh *b, const double *item_boxes, const double
         int32_t k = stack[--depth];
         const wc_bvh_node *node = b->nodes + k;
         if ((any && box_holds(out, node_boxes + 6 * (size_t)k)) || !overlap(node->box, box)) continue;
-        /* a node inside the box: every item of it overlaps, its value box is theirs */
-        if (box_holds(box, node->box)) {
+        /* a node inside the box: every item of it overlaps, its value box is
+         * theirs; a small one is taken whole too */
+        if (box_holds(box, node->box) || box_within_size(node->box, whole_below)) {
             box_join(out, node_boxes + 6 * (size_t)k), any = 1;
             continue;
         }

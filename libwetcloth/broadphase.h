@@ -72,11 +72,13 @@ int32_t wci_bvh_collect(const wc_bvh *bvh, const double box[6], int32_t *out, in
 void wci_bvh_fold_boxes(const wc_bvh *bvh, const double *item_boxes, double *node_boxes);
 
 /// The union of the value boxes of the items whose boxes overlap `box`, into
-/// `out`; returns 0 (and leaves `out` empty: min > max) if there are none.
-/// Uses the node value boxes that wci_bvh_fold_boxes made from the same item
-/// boxes to skip every node whose value box the union already holds.
+/// `out`, and perhaps of some more: a node whose box overlaps `box` and has
+/// no side longer than `whole_below` is taken whole (0: none is). Returns
+/// 0 (and leaves `out` empty: min > max) if there are none. Uses the node
+/// value boxes that wci_bvh_fold_boxes made from the same item boxes to
+/// skip every node whose value box the union already holds.
 int wci_bvh_union_within(const wc_bvh *bvh, const double *item_boxes, const double *node_boxes,
-                         const double box[6], double out[6]);
+                         const double box[6], double whole_below, double out[6]);
 
 /// Distance from point p to the tree's root box (0 inside it; +inf for an
 /// empty tree): no item is nearer.

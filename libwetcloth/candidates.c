@@ -32,6 +32,15 @@
  * lie in the cube of half-side S, and a displacement is no farther from it
  * than that cube's diagonal, 2 sqrt(3) S. */
 #define LOCAL_STEP_MOST 3.5
+/* How much wider than it needs a particle's cube is counted, in r
+ * (own_step_of). */
+#define REACH_SLACK 0.25
+/* A node of the collider's tree that meets a particle's cube and is no
+ * larger than this fraction of its half-side is taken whole in the count
+ * of its own step, rather than triangle by triangle: a few triangles just
+ * outside the cube, whose displacements differ little from those inside
+ * (own_step_of). */
+#define WHOLE_BELOW 0.5
 
 
 static void makers_free(wc_candidates *c);
@@ -48,6 +57,7 @@ void wci_candidates_destroy(wc_candidates *c)
     wci_free(c->base), wci_free(c->margin), wci_free(c->base_path);
     wci_free(c->local_path), wci_free(c->local_step), wci_free(c->particle_mark);
     wci_free(c->frame), wci_free(c->frame_step), wci_free(c->own_step), wci_free(c->again);
+    wci_free(c->own_reach);
     lists_free(&c->particles), lists_free(&c->triangles), lists_free(&c->edges);
     makers_free(c);
     wci_free(c->jobs);
@@ -575,9 +585,10 @@ static int allocate(wc_candidates *c, const wc_cloth_elements *el)
     if (!c->frame) c->frame = wci_alloc_array(3 * n, sizeof *c->frame);
     if (!c->frame_step) c->frame_step = wci_alloc_array(3 * n, sizeof *c->frame_step);
     if (!c->own_step) c->own_step = wci_alloc_array(n, sizeof *c->own_step);
+    if (!c->own_reach) c->own_reach = wci_alloc_array(n, sizeof *c->own_reach);
     if (!c->again) c->again = wci_alloc_array(2 * n, sizeof *c->again);
     return c->base && c->margin && c->base_path && c->local_path && c->local_step && c->particle_mark &&
-           c->frame && c->frame_step && c->own_step && c->again;
+           c->frame && c->frame_step && c->own_step && c->own_reach && c->again;
 }
 
 wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
@@ -708,7 +719,10 @@ static double local_reach(const wc_candidates *c, const wc_cloth_elements *el, c
  * frame's step first, to the centre of the box of their displacements (a
  * collider carrying the cloth along then moves by about nothing relative
  * to it); otherwise the frame's step stays as chosen at the start of the
- * step, since snapshots taken since count from it. */
+ * step, since snapshots taken since count from it. The cube is counted a
+ * little wider than it needs (by REACH_SLACK r), so that a neighbour's
+ * rebase, which widens it a little, seldom needs it counted again: a
+ * wider cube holds more triangles and gives a bound as good. */
 static void own_step_of(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col, int32_t i,
                         int choose)
 {
@@ -718,10 +732,15 @@ static void own_step_of(wc_candidates *c, const wc_cloth_elements *el, const wc_
         if (choose) u[0] = u[1] = u[2] = 0.0;
         return;
     }
-    double b[3], reach = local_reach(c, el, col, i), box[6], shift[6];
+    double reach = local_reach(c, el, col, i);
+    if (!choose && reach <= c->own_reach[i]) return;
+    reach += REACH_SLACK * c->r;
+    c->own_reach[i] = reach;
+    double b[3], box[6], shift[6];
     base_of(c, i, b);
     for (int k = 0; k < 3; ++k) box[k] = b[k] - reach, box[k + 3] = b[k] + reach;
-    if (!wci_bvh_union_within(&col->bvh, col->triangle_shift, col->node_shift, box, shift)) {
+    if (!wci_bvh_union_within(&col->bvh, col->triangle_shift, col->node_shift, box, WHOLE_BELOW * reach,
+                              shift)) {
         if (choose) u[0] = u[1] = u[2] = 0.0;
         c->own_step[i] = 0.0;
         return;

@@ -161,6 +161,8 @@ typedef struct wc_candidates {
     /// steps, and this step's (xyz each; see relative motion above), and its
     /// own step (the local step before its neighbours' are taken in).
     double *frame, *frame_step, *own_step;
+    /// Per particle: the half-side of the cube its own step was counted in.
+    double *own_reach;
     /// Whether any frame has moved: until one does (a collider that stands
     /// still), every frame is 0 and is not read.
     int framed;
