@@ -10,7 +10,10 @@ Run it with the Python that has bpy (4.5):
 
 A scene name takes flags after "+": wet (soaked), self (self-collision),
 xpbd12 (both builds with XPBD at 12 steps per frame instead of each one's
-default).
+default), carry (from the run's middle frame on the collider moves along x
+at CARRY m/s, carrying the cloth that rests on it: bench_contacts carry=;
+in Blender the collider object's location, set by a frame-change handler;
+the base build does not run these).
 
 Ours: build/tools/bench_contacts with this build's library, and the base
 build's own tools/bench_contacts with its library (built from that commit,
@@ -50,6 +53,7 @@ import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 FRAME = 1.0 / 24
+CARRY = 0.5  # m/s, the +carry scenes' collider speed
 
 # name: (cloth particles per side, width m, start height m, collider maker, deforming)
 SCENES = {
@@ -177,7 +181,14 @@ def rms(a, b, width):
 # Blender
 
 
-def blender_run(scene, frames, quality, self_collision, thickness=0.02):
+def carried(frame_index, frames, speed):
+    """bench_contacts.c's carry: the collider's shift along x before the
+    advance from frame `frame_index` (0-based) to the next."""
+    k = frame_index + 1 - frames // 2
+    return speed * k / 24.0 if k > 0 else 0.0
+
+
+def blender_run(scene, frames, quality, self_collision, thickness=0.02, carry=0.0):
     import bpy
     n, width, height, spec, deforming = SCENES[scene]
     bpy.ops.wm.read_homefile(use_empty=True)
@@ -205,12 +216,15 @@ def blender_run(scene, frames, quality, self_collision, thickness=0.02):
     mod.point_cache.frame_start = 1
     mod.point_cache.frame_end = frames + 1
     handler = None
-    if deforming:
+    if deforming or carry:
         def handler(s, depsgraph=None):
             f = s.frame_current
-            pos = bent(cv, min(1.0, max(0.0, (f - 1) / frames)))
-            me.vertices.foreach_set("co", pos.ravel())
-            me.update()
+            if deforming:
+                pos = bent(cv, min(1.0, max(0.0, (f - 1) / frames)))
+                me.vertices.foreach_set("co", pos.ravel())
+                me.update()
+            # frame f ends our advance from frame index f - 2
+            ob.location.x = carried(f - 2, frames, carry) if f >= 2 else 0.0
         bpy.app.handlers.frame_change_pre.append(handler)
     sc.frame_set(1)
     out = np.empty((frames, n * n, 3))
@@ -263,7 +277,8 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--base", help="build folder of the commit before (its libwetcloth.so)")
     ap.add_argument("--scenes", default="thesis,thesis+self,sphere64,sphere64+xpbd12,sphere176,"
-                                        "sphere176+xpbd12,soaked,soaked+wet,cylinder,cylinder+wet")
+                                        "sphere176+xpbd12,soaked,soaked+wet,cylinder,cylinder+wet,"
+                                        "sphere64+carry,sphere176+carry")
     ap.add_argument("--frames", type=int, default=24)
     ap.add_argument("--reps", type=int, default=2)
     ap.add_argument("--sweep", default="2,5,10,20", help="Blender qualities for the error sweep")
@@ -284,15 +299,18 @@ def main():
     for item in a.scenes.split(","):
         scene, *flags = item.split("+")
         wet, self_c = int("wet" in flags), int("self" in flags)
+        carry = CARRY if "carry" in flags else 0.0
         n, width, height, spec, deforming = SCENES[scene]
         extra = [f"wet={wet}", f"self={self_c}", "thickness=0.02", "friction=0.5", "threads=1"]
         # +xpbd12: both builds at the same setting (XPBD, 12 steps per frame),
         # so that the collision cost compares like with like
         if "xpbd12" in flags:
             extra += ["integrator=xpbd", "steps=12"]
+        if carry:
+            extra.append(f"carry={carry}")
         new_runs, base_runs = [], []
         for rep in range(a.reps):
-            if base_lib:
+            if base_lib and not carry:
                 bf = a.base_frames or a.frames
                 base_runs.append(ours(base_program, base_lib, scene, bf, extra))
             new_runs.append(ours(program, build_lib, scene, a.frames, extra,
@@ -309,14 +327,15 @@ def main():
             ref_ok = ref["finite"]
         row = {"scene": item, "ours": new_runs, "base": base_runs, "error": err}
         if not a.no_blender:
-            key = (scene, self_c)
+            key = (scene, self_c, carry)
             if key not in blender_cache:
-                b5 = [blender_run(scene, a.frames, 5, bool(self_c)) for _ in range(max(1, a.reps))]
+                b5 = [blender_run(scene, a.frames, 5, bool(self_c), carry=carry) for _ in range(max(1, a.reps))]
                 qs = {}
                 if sweep:
-                    ref_wall, ref_pos = blender_run(scene, a.frames, a.reference_quality, bool(self_c))
+                    ref_wall, ref_pos = blender_run(scene, a.frames, a.reference_quality, bool(self_c),
+                                                    carry=carry)
                     for q in sweep:
-                        w_, p_ = (b5[0] if q == 5 else blender_run(scene, a.frames, q, bool(self_c)))
+                        w_, p_ = (b5[0] if q == 5 else blender_run(scene, a.frames, q, bool(self_c), carry=carry))
                         qs[q] = (w_, rms(p_, ref_pos, width))
                 hi, longest = stability(b5[0][1], height, grid_links(n))
                 blender_cache[key] = {"q5_s": [b[0] for b in b5], "sweep": qs,
