@@ -41,6 +41,10 @@
  * outside the cube, whose displacements differ little from those inside
  * (own_step_of). */
 #define WHOLE_BELOW 0.5
+/* A collider whose displacements in a step all lie within this distance,
+ * in r, of their common centre gives every particle that centre as its
+ * frame's step, without a count per particle. */
+#define WHOLE_COLLIDER_SPREAD 0.01
 
 
 static void makers_free(wc_candidates *c);
@@ -764,6 +768,22 @@ void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el, 
         /* every frame stands still this step, and every step is the same */
         for (int32_t i = 0; i < el->particle_count; ++i) own_step_of(c, el, col, i, 1);
         for (int32_t i = 0; i < el->particle_count; ++i) c->local_step[i] = c->own_step[i];
+        return;
+    }
+    /* A collider that moves as one piece (a prop, a vehicle, a character's
+     * root motion) displaces its vertices by nearly the same vector: the
+     * box of all its displacements, at the tree's root, is then small, and
+     * its centre serves every particle as well as a count of its own. */
+    const double *all = col->node_shift;
+    double half2 = 0.0;
+    for (int k = 0; k < 3; ++k) half2 += 0.25 * (all[k + 3] - all[k]) * (all[k + 3] - all[k]);
+    if (col->bvh.node_count > 0 && sqrt(half2) <= WHOLE_COLLIDER_SPREAD * c->r) {
+        for (int32_t i = 0; i < el->particle_count; ++i) {
+            for (int k = 0; k < 3; ++k) c->frame_step[3 * (size_t)i + k] = 0.5 * (all[k] + all[k + 3]);
+            /* it holds for any cube: no recount needs it again */
+            c->own_step[i] = c->local_step[i] = sqrt(half2), c->own_reach[i] = INFINITY;
+        }
+        c->framed = 1;
         return;
     }
     for (int32_t i = 0; i < el->particle_count; ++i) own_step_of(c, el, col, i, 1);
