@@ -45,6 +45,9 @@
  * in r, of their common centre gives every particle that centre as its
  * frame's step, without a count per particle. */
 #define WHOLE_COLLIDER_SPREAD 0.01
+/* From this many particles the count of their own steps (a query of the
+ * collider's tree each) runs on the step's threads. */
+#define LOCAL_MOTION_PARALLEL_MIN 256
 
 
 static void makers_free(wc_candidates *c);
@@ -619,7 +622,7 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
         c->r = 0.0; /* made again at the next use */
         return WC_ERROR_OUT_OF_MEMORY;
     }
-    wci_candidates_local_motion(c, el, col);
+    wci_candidates_local_motion(c, el, col, threads);
     return WC_OK;
 }
 
@@ -727,17 +730,17 @@ static double local_reach(const wc_candidates *c, const wc_cloth_elements *el, c
  * little wider than it needs (by REACH_SLACK r), so that a neighbour's
  * rebase, which widens it a little, seldom needs it counted again: a
  * wider cube holds more triangles and gives a bound as good. */
-static void own_step_of(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col, int32_t i,
-                        int choose)
+static int own_step_of(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col, int32_t i,
+                       int choose)
 {
     double *u = c->frame_step + 3 * (size_t)i;
     if (!(col->step_motion > 0.0) || c->whole_collider) {
         c->own_step[i] = col->step_motion;
         if (choose) u[0] = u[1] = u[2] = 0.0;
-        return;
+        return 0;
     }
     double reach = local_reach(c, el, col, i);
-    if (!choose && reach <= c->own_reach[i]) return;
+    if (!choose && reach <= c->own_reach[i]) return 0;
     reach += REACH_SLACK * c->r;
     c->own_reach[i] = reach;
     double b[3], box[6], shift[6];
@@ -747,12 +750,10 @@ static void own_step_of(wc_candidates *c, const wc_cloth_elements *el, const wc_
                               shift)) {
         if (choose) u[0] = u[1] = u[2] = 0.0;
         c->own_step[i] = 0.0;
-        return;
+        return 0;
     }
-    if (choose) {
+    if (choose)
         for (int k = 0; k < 3; ++k) u[k] = 0.5 * (shift[k] + shift[k + 3]);
-        if (u[0] != 0.0 || u[1] != 0.0 || u[2] != 0.0) c->framed = 1;
-    }
     /* the farthest corner of the box from the frame's step */
     double far2 = 0.0;
     for (int k = 0; k < 3; ++k) {
@@ -760,9 +761,46 @@ static void own_step_of(wc_candidates *c, const wc_cloth_elements *el, const wc_
         far2 += g * g;
     }
     c->own_step[i] = sqrt(far2);
+    return u[0] != 0.0 || u[1] != 0.0 || u[2] != 0.0;
 }
 
-void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col)
+/* What the count of every particle's own and local steps reads. */
+typedef struct local_motion_pass {
+    wc_candidates *cand;
+    const wc_cloth_elements *el;
+    const wc_collider *col;
+} local_motion_pass;
+
+/* Own steps of particles [begin, end), with their frames' steps chosen;
+ * nonzero if any frame moves. */
+static int own_steps_range(void *context, int64_t begin, int64_t end)
+{
+    const local_motion_pass *pass = context;
+    int moved = 0;
+    for (int64_t i = begin; i < end; ++i) moved |= own_step_of(pass->cand, pass->el, pass->col, (int32_t)i, 1);
+    return moved;
+}
+
+/* Local steps of particles [begin, end): an element's pairs move relative
+ * to its particles' frames by no more than the largest of their own steps
+ * (candidates.h, relative motion), and every element of i has only i and
+ * its neighbours. */
+static int local_steps_range(void *context, int64_t begin, int64_t end)
+{
+    const local_motion_pass *pass = context;
+    wc_candidates *c = pass->cand;
+    const wc_cloth_elements *el = pass->el;
+    for (int64_t i = begin; i < end; ++i) {
+        double most = c->own_step[i];
+        for (int32_t m = el->edges_start[i]; m < el->edges_start[i + 1]; ++m)
+            if (c->own_step[neighbour(el, (int32_t)i, m)] > most) most = c->own_step[neighbour(el, (int32_t)i, m)];
+        c->local_step[i] = most;
+    }
+    return 0;
+}
+
+void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
+                                 int threads)
 {
     if (!(col->step_motion > 0.0) || c->whole_collider) {
         /* every frame stands still this step, and every step is the same */
@@ -786,16 +824,11 @@ void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el, 
         c->framed = 1;
         return;
     }
-    for (int32_t i = 0; i < el->particle_count; ++i) own_step_of(c, el, col, i, 1);
-    /* an element's pairs move relative to its particles' frames by no more
-     * than the largest of their own steps (candidates.h, relative motion),
-     * and every element of i has only i and its neighbours */
-    for (int32_t i = 0; i < el->particle_count; ++i) {
-        double most = c->own_step[i];
-        for (int32_t m = el->edges_start[i]; m < el->edges_start[i + 1]; ++m)
-            if (c->own_step[neighbour(el, i, m)] > most) most = c->own_step[neighbour(el, i, m)];
-        c->local_step[i] = most;
-    }
+    /* a tree query per particle: worth a team from a few hundred */
+    int team = el->particle_count >= LOCAL_MOTION_PARALLEL_MIN ? threads : 1;
+    local_motion_pass pass = {c, el, col};
+    if (wci_parallel_for(el->particle_count, team, own_steps_range, &pass)) c->framed = 1;
+    wci_parallel_for(el->particle_count, team, local_steps_range, &pass);
 }
 
 /* Particle j's own step taken into its local step and its neighbours'

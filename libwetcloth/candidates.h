@@ -234,8 +234,9 @@ static inline int wc_candidates_rebase_due(const wc_candidates *cand, int32_t i,
 /// of the box of their displacements, its own step the farthest of them
 /// from it, and its local step the largest own step of it and its
 /// neighbours. 0 for a collider that stands still.
+/// Runs on up to `threads` threads, the same values for any count.
 void wci_candidates_local_motion(wc_candidates *cand, const wc_cloth_elements *el,
-                                 const wc_collider *col);
+                                 const wc_collider *col, int threads);
 
 /// After a committed step: every particle's local step added to its path
 /// and its frame's step to its frame.

@@ -265,7 +265,7 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
             if (wci_candidates_update(cand, &s->el, col, r, p, steps_left, threads))
                 return WC_ERROR_OUT_OF_MEMORY;
         } else {
-            wci_candidates_local_motion(cand, &s->el, col);
+            wci_candidates_local_motion(cand, &s->el, col, threads);
         }
         for (int32_t i = 0; i < c->particle_count; ++i)
             if (wc_candidates_rebase_due(cand, i, wci_candidates_displacement(cand, p, i)))
