@@ -913,37 +913,37 @@ double wci_candidates_ceiling(const wc_candidates *c, double r, const int32_t *i
     return r + element_margin(c, idx, count) - sqrt(far2);
 }
 
-/* The larger distance of particle i in its frame at the start and at the
- * end of the step from a point of its frame: by convexity (the particle
- * and its frame both move linearly in the step), the most it is from it
- * over the step. */
-static double farthest_over_step(const wc_candidates *c, const wc_particle_arrays *p, int32_t i,
-                                 const double at[3])
+/* The larger squared distance of particle i in its frame at the start and
+ * at the end of the step from a point of its frame: by convexity (the
+ * particle and its frame both move linearly in the step), the most it is
+ * from it over the step, squared (the callers take one root of the largest
+ * of several: the filter of every element visit reads it). */
+static double farthest2_over_step(const wc_candidates *c, const wc_particle_arrays *p, int32_t i,
+                                  const double at[3])
 {
-    double f[3], e[3];
-    frame_of(c, i, 0, f);
-    end_in_frame(c, p, i, e);
+    double f[3] = {0.0, 0.0, 0.0}, e[3] = {p->nx[i], p->ny[i], p->nz[i]};
+    if (c->framed) frame_of(c, i, 0, f), end_in_frame(c, p, i, e);
     double s[3] = {p->x[i] - f[0] - at[0], p->y[i] - f[1] - at[1], p->z[i] - f[2] - at[2]};
     double t[3] = {e[0] - at[0], e[1] - at[1], e[2] - at[2]};
     double s2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2], e2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
-    return sqrt(s2 > e2 ? s2 : e2);
+    return s2 > e2 ? s2 : e2;
 }
 
 double wci_candidates_displacement(const wc_candidates *c, const wc_particle_arrays *p, int32_t i)
 {
-    return farthest_over_step(c, p, i, c->base + 3 * (size_t)i);
+    return sqrt(farthest2_over_step(c, p, i, c->base + 3 * (size_t)i));
 }
 
 double wci_pair_lists_drift(const wc_candidates *c, const wc_pair_lists *l, int32_t k,
                            const int32_t *particles, const wc_particle_arrays *p)
 {
     const double *snap = l->snap + 3 * (size_t)l->per * (size_t)k;
-    double most = 0.0;
+    double most2 = 0.0;
     for (int j = 0; j < l->per; ++j) {
-        double d = farthest_over_step(c, p, particles[j], snap + 3 * j);
-        if (d > most) most = d;
+        double d2 = farthest2_over_step(c, p, particles[j], snap + 3 * j);
+        if (d2 > most2) most2 = d2;
     }
-    return most;
+    return sqrt(most2);
 }
 
 double wci_pair_lists_end_drift(const wc_candidates *c, const wc_pair_lists *l, int32_t k,
