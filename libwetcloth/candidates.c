@@ -818,8 +818,10 @@ void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el, 
     if (col->bvh.node_count > 0 && sqrt(half2) <= WHOLE_COLLIDER_SPREAD * c->r) {
         for (int32_t i = 0; i < el->particle_count; ++i) {
             for (int k = 0; k < 3; ++k) c->frame_step[3 * (size_t)i + k] = 0.5 * (all[k] + all[k + 3]);
+            c->own_step[i] = sqrt(half2);
+            c->local_step[i] = c->own_step[i];
             /* it holds for any cube: no recount needs it again */
-            c->own_step[i] = c->local_step[i] = sqrt(half2), c->own_reach[i] = INFINITY;
+            c->own_reach[i] = INFINITY;
         }
         c->framed = 1;
         return;
