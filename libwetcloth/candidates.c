@@ -39,7 +39,8 @@
  * larger than this fraction of its half-side is taken whole in the count
  * of its own step, rather than triangle by triangle: a few triangles just
  * outside the cube, whose displacements differ little from those inside
- * (own_step_of). */
+ * (own_step_of). On the bending tube, three alternated runs, dry: 147-162
+ * ms per frame at 0.5, 168-189 taking no node whole, 148-174 at 1.0. */
 #define WHOLE_BELOW 0.5
 /* A collider whose displacements in a step all lie within this distance,
  * in r, of their common centre gives every particle that centre as its
