@@ -627,8 +627,9 @@ WC_API wc_status wc_world_add_mesh_collider(wc_world *world, const wc_mesh_colli
 /// finite; count = its vertex count). They are reached at the end of the
 /// next wc_world_step() or wc_world_advance(), moving linearly across its
 /// substeps; contacts use the relative motion, so fast colliders do not
-/// tunnel through cloth. A mesh that moves as one piece costs a cloth that
-/// rests on it about what a still one does (docs/c-api.md, Colliders).
+/// tunnel through cloth. A mesh that moves as one piece costs the cloth on
+/// it only what the cloth's motion against it costs (docs/c-api.md,
+/// Colliders).
 WC_API wc_status wc_collider_set_vertices(wc_world *world, int32_t collider, const double *xyz,
                                           int32_t count);
 
