@@ -205,6 +205,22 @@ void wci_collider_contacts_use_local_motion(wc_collider_contacts *s, int use) { 
 
 int64_t wci_collider_contacts_feature_tests(const wc_collider_contacts *s) { return s->feature_tests; }
 
+int32_t wci_collider_contacts_uncovered(const wc_collider_contacts *s, const wc_cloth *c)
+{
+    /* between steps a particle is where the last step ended: its start and
+     * end are both that (the end arrays hold the step's leftovers) */
+    wc_particle_arrays p = wci_particle_arrays_of((wc_cloth *)c);
+    p.nx = (double *)p.x, p.ny = (double *)p.y, p.nz = (double *)p.z;
+    int32_t n = 0;
+    for (int32_t k = 0; k < s->cand_count; ++k) {
+        const wc_candidates *cand = &s->cand[k];
+        if (!(cand->r > 0.0)) continue; /* never made: no lists to cover */
+        for (int32_t i = 0; i < c->particle_count; ++i)
+            n += !wc_candidates_covers(cand, i, wci_candidates_displacement(cand, &p, i));
+    }
+    return n;
+}
+
 /* ------------------------------------------------------------------------ */
 /* Candidates                                                               */
 /* ------------------------------------------------------------------------ */

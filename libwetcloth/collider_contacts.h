@@ -78,4 +78,10 @@ void wci_collider_contacts_use_filter(wc_collider_contacts *state, int use);
 /// what the filter left (tests/test_collide.c).
 int64_t wci_collider_contacts_feature_tests(const wc_collider_contacts *state);
 
+/// A test's check of the candidates' invariant: how many particles of the
+/// cloth are, against some mesh collider, farther from their lists' cover
+/// than it allows (wc_candidates_covers); 0 whenever the stage is between
+/// steps.
+int32_t wci_collider_contacts_uncovered(const wc_collider_contacts *state, const wc_cloth *cloth);
+
 #endif
