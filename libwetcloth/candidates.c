@@ -45,7 +45,7 @@
 /* A collider whose displacements in a step all lie within this distance,
  * in r, of their common centre gives every particle that centre as its
  * frame's step, without a count per particle. */
-#define WHOLE_COLLIDER_SPREAD 0.01
+#define ONE_PIECE_SPREAD 0.01
 /* From this many particles the count of their own steps (a query of the
  * collider's tree each) runs on the step's threads. */
 #define LOCAL_MOTION_PARALLEL_MIN 256
@@ -800,33 +800,41 @@ static int local_steps_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
+/* A collider that moves as one piece (a prop, a vehicle, a character's
+ * root motion) displaces its vertices by nearly the same vector: the box of
+ * all its displacements, at the tree's root, is then small, and its centre
+ * serves every particle as well as a count of its own. Returns 0 (and
+ * leaves everything) for a collider that does not. */
+static int frames_of_one_piece(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col)
+{
+    if (col->bvh.node_count == 0) return 0;
+    const double *all = col->node_shift;
+    double half2 = 0.0;
+    for (int k = 0; k < 3; ++k) half2 += 0.25 * (all[k + 3] - all[k]) * (all[k + 3] - all[k]);
+    if (!(sqrt(half2) <= ONE_PIECE_SPREAD * c->r)) return 0;
+    for (int32_t i = 0; i < el->particle_count; ++i) {
+        for (int k = 0; k < 3; ++k) c->frame_step[3 * (size_t)i + k] = 0.5 * (all[k] + all[k + 3]);
+        c->own_step[i] = sqrt(half2);
+        c->local_step[i] = c->own_step[i];
+        /* it holds for any cube: no recount needs it again */
+        c->own_reach[i] = INFINITY;
+    }
+    c->framed = 1;
+    return 1;
+}
+
 void wci_candidates_local_motion(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
                                  int threads)
 {
     if (!(col->step_motion > 0.0) || c->whole_collider) {
         /* every frame stands still this step, and every step is the same */
-        for (int32_t i = 0; i < el->particle_count; ++i) own_step_of(c, el, col, i, 1);
-        for (int32_t i = 0; i < el->particle_count; ++i) c->local_step[i] = c->own_step[i];
-        return;
-    }
-    /* A collider that moves as one piece (a prop, a vehicle, a character's
-     * root motion) displaces its vertices by nearly the same vector: the
-     * box of all its displacements, at the tree's root, is then small, and
-     * its centre serves every particle as well as a count of its own. */
-    const double *all = col->node_shift;
-    double half2 = 0.0;
-    for (int k = 0; k < 3; ++k) half2 += 0.25 * (all[k + 3] - all[k]) * (all[k + 3] - all[k]);
-    if (col->bvh.node_count > 0 && sqrt(half2) <= WHOLE_COLLIDER_SPREAD * c->r) {
         for (int32_t i = 0; i < el->particle_count; ++i) {
-            for (int k = 0; k < 3; ++k) c->frame_step[3 * (size_t)i + k] = 0.5 * (all[k] + all[k + 3]);
-            c->own_step[i] = sqrt(half2);
+            own_step_of(c, el, col, i, 1);
             c->local_step[i] = c->own_step[i];
-            /* it holds for any cube: no recount needs it again */
-            c->own_reach[i] = INFINITY;
         }
-        c->framed = 1;
         return;
     }
+    if (frames_of_one_piece(c, el, col)) return;
     /* a tree query per particle: worth a team from a few hundred */
     int team = el->particle_count >= LOCAL_MOTION_PARALLEL_MIN ? threads : 1;
     local_motion_pass pass = {c, el, col};
