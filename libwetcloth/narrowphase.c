@@ -108,6 +108,39 @@ static void surface_contact(int32_t particle, const double end[3], const double 
     }
 }
 
+/* Cheap rejection for a moving triangle, the one that needs no normals:
+ * whether the particle stays farther than r from triangle t over the whole
+ * step, so that neither the distance test nor the continuous one can
+ * answer. Each point of the triangle is q(t) = sum w_k c_k(t), corners and
+ * particle moving linearly, so p(t) - q(t) = (p(1) - q(1)) - (1 - t) sum
+ * w_k d_k, d_k the particle's displacement less corner k's; the distance
+ * at any time is then at least the end's less max_k |d_k|. A triangle that
+ * is not apart still has the end's squared distance in *d2 and its
+ * closest point's weights in w, which the full test goes on from. Returns
+ * 1 if apart, 0 if not, -1 for a triangle degenerate at the end (which the
+ * full test ignores, measuring nothing). The slack of 1e-9 r covers the
+ * rounding of the continuous test's own distances. */
+static int moving_triangle_apart(const wc_collider *c, int32_t t, const double start[3],
+                                 const double end[3], double r, double *d2, double w[3])
+{
+    double t1[3][3], u[3], v[3], m[3], most2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        int32_t corner = c->triangles[3 * (size_t)t + k];
+        double c0[3], d[3];
+        vertex_of(c->current, corner, c0);
+        vertex_of(c->next, corner, t1[k]);
+        for (int j = 0; j < 3; ++j) d[j] = (end[j] - start[j]) - (t1[k][j] - c0[j]);
+        if (dot3(d, d) > most2) most2 = dot3(d, d);
+    }
+    sub3(t1[1], t1[0], u);
+    sub3(t1[2], t1[0], v);
+    cross3(u, v, m);
+    if (!(dot3(m, m) > 0.0)) return -1;
+    *d2 = wci_point_triangle_closest(end, t1[0], t1[1], t1[2], w);
+    double clear = r * (1.0 + 1e-9) + sqrt(most2);
+    return *d2 > clear * clear;
+}
+
 int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particle,
                                 const double start[3], const double end[3], double r,
                                 double *end_d2, wc_contact *out)
@@ -127,10 +160,16 @@ int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t partic
             return 0;
         }
     }
+    double w[3], cp[3], offset[3], tc, d2 = 0.0;
+    if (c->moving) {
+        int apart = moving_triangle_apart(c, t, start, end, r, &d2, w);
+        if (apart < 0) return 0;
+        *end_d2 = d2;
+        if (apart) return 0;
+    }
     triangle_motion(c, t, t0, t1, n0, n1);
     if (n1[0] == 0.0 && n1[1] == 0.0 && n1[2] == 0.0) return 0;
-    double w[3], cp[3], offset[3], tc;
-    double d2 = wci_point_triangle_closest(end, t1[0], t1[1], t1[2], w);
+    if (!c->moving) d2 = wci_point_triangle_closest(end, t1[0], t1[1], t1[2], w);
     *end_d2 = d2;
     bary_point(t1[0], t1[1], t1[2], w, cp);
     for (int k = 0; k < 3; ++k) offset[k] = end[k] - cp[k];

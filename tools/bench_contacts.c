@@ -309,7 +309,7 @@ int main(int argc, char **argv)
     double wall = 0.0, collide = 0.0, highest = -INFINITY, stretch = 0.0;
     int64_t substeps = 0;
     int landed = -1, finite = 1, worst_intersections = 0, last_intersections = 0, last_collider = 0;
-    int64_t failsafe = 0, halved = 0;
+    int64_t failsafe = 0, halved = 0, iterations = 0;
     /* a library built before wc_step_stats.halved_steps returns a shorter
      * struct (the commit before, run side by side): its count reads 0 */
     int has_halved = wc_struct_size("wc_step_stats") >= (int64_t)sizeof(wc_step_stats);
@@ -337,6 +337,7 @@ int main(int argc, char **argv)
         failsafe += stats.failsafe_particles;
         int frame_halved = has_halved ? stats.halved_steps : 0;
         halved += frame_halved;
+        iterations += stats.solver_iterations;
         substeps += wc_world_last_substeps(s.world);
         bench_check(wc_cloth_get_positions(s.world, s.cloth, xyz, n), s.world, "positions");
         bench_check(wc_cloth_get_contacts(s.world, s.cloth, contact, NULL, n), s.world, "contacts");
@@ -356,9 +357,11 @@ int main(int argc, char **argv)
             if (last_intersections > worst_intersections) worst_intersections = last_intersections;
         }
         if (o.trace)
-            fprintf(stderr, "frame %d: %.1f ms (collide %.1f), longest link %.3f, fail-safe %lld, "
-                            "halved steps %d, intersections %d (with the collider %d)\n",
-                    f, 1e3 * frame_seconds, 1e3 * stats.collide_seconds,
+            fprintf(stderr, "frame %d: %.1f ms (collide %.1f, integrate %.1f, %lld solver iterations), "
+                            "longest link %.3f, fail-safe %lld, halved steps %d, intersections %d "
+                            "(with the collider %d)\n",
+                    f, 1e3 * frame_seconds, 1e3 * stats.collide_seconds, 1e3 * stats.integrate_seconds,
+                    (long long)stats.solver_iterations,
                     longest, (long long)stats.failsafe_particles, frame_halved,
                     o.check == 2 ? last_intersections : -1, o.check == 2 ? last_collider : -1);
     }
@@ -370,13 +373,15 @@ int main(int argc, char **argv)
            "\"substeps_per_frame\": %.2f, \"intersections_last\": %d, \"intersections_worst\": %d, "
            "\"landed_frame\": %d, \"start_height\": %.4f, \"highest_after_landing\": %.4f, "
            "\"longest_link\": %.4f, \"finite\": %d, \"cloth_collider_last\": %d, "
-           "\"failsafe_last_substeps\": %lld, \"halved_steps\": %lld}\n",
+           "\"failsafe_last_substeps\": %lld, \"halved_steps\": %lld, "
+           "\"solver_iterations_per_step\": %.2f}\n",
            o.scene, wc_version_string(), o.integrator, o.wet, o.self, (int)n,
            (int)s.collider_mesh.triangle_count, o.thickness, frames_done, o.threads,
            1e3 * wall / frames_done, 1e3 * collide / frames_done, (double)substeps / frames_done,
            last_intersections, worst_intersections, landed, s.start_height,
            landed >= 0 ? highest : s.start_height, stretch, finite, last_collider,
-           (long long)failsafe, (long long)halved);
+           (long long)failsafe, (long long)halved,
+           substeps > 0 ? (double)iterations / (double)substeps : 0.0);
     wc_world_destroy(s.world);
     free(pairs), free(rest), free(xyz), free(bent), free(contact);
     free(s.collider_mesh.v), free(s.collider_mesh.t);
