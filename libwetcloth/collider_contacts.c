@@ -359,6 +359,19 @@ static int32_t gather_one(int32_t j, double d, double bound, int32_t *out, int32
     return n + keep;
 }
 
+/* The position of the first of the ascending items[0 .. count) above
+ * `after` (count if none; 0 for after < 0). */
+static int32_t first_after(const int32_t *items, int32_t count, int32_t after)
+{
+    int32_t lo = 0, hi = count;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (items[mid] <= after) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
 /* Positions in owner k's list (ascending by item) of the items after
  * `after` whose bound d is within `bound` (all of them when `all`), into out,
  * which has room for the whole list; returns how many. *rest gets the least
@@ -371,14 +384,15 @@ static int32_t survivors(const wc_pair_lists *l, int32_t k, double bound, int al
     if (l->count[k] == 0) return 0; /* (the pool may not exist yet) */
     const int32_t *item = l->item + l->start[k];
     const double *d = l->d + l->start[k];
-    int32_t n = 0, count = l->count[k], j = 0;
-    if (after < 0 && !all) {
-        /* The first gathering of a visit (most of them): every item comes
-         * after, so only the bounds are read, without a branch (which items
-         * the filter keeps changes from visit to visit, and mispredicted
-         * skips made this scan a tenth of a dense collider's step), and
-         * into four running minima (one would chain every item's compare to
-         * the last one's; the least of a set is the same however grouped). */
+    int32_t n = 0, count = l->count[k], j = first_after(item, count, after);
+    if (!all) {
+        /* Only the bounds are read, from the first item after `after` on
+         * (a gathering after a push starts there: the items are
+         * ascending), without a branch (which items the filter keeps
+         * changes from visit to visit, and mispredicted skips made this
+         * scan a tenth of a dense collider's step), and into four running
+         * minima (one would chain every item's compare to the last one's;
+         * the least of a set is the same however grouped). */
         double least[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
         for (; j + 4 <= count; j += 4) {
             n = gather_one(j, d[j], bound, out, n, &least[0]);
@@ -391,13 +405,7 @@ static int32_t survivors(const wc_pair_lists *l, int32_t k, double bound, int al
         *rest = a < b ? a : b;
         return n;
     }
-    double least = INFINITY;
-    for (; j < count; ++j) {
-        if (item[j] <= after) continue;
-        if (all) out[n++] = j;
-        else n = gather_one(j, d[j], bound, out, n, &least);
-    }
-    *rest = least;
+    for (; j < count; ++j) out[n++] = j;
     return n;
 }
 
