@@ -25,6 +25,11 @@
  * distance (on top of r): far more than the rounding of the distances
  * behind it, far less than anything physical. */
 #define FILTER_EPSILON(r) (1e-9 * (r) + 1e-12)
+/* A cloth whose box is farther from every collider than APART_BECOMES
+ * times the contact distance skips the stage; it stays apart while that is
+ * more than APART_STAYS times it (see wci_collider_contacts_resolve). */
+#define APART_BECOMES 2.0
+#define APART_STAYS 1.001
 /* A particle's direct query (when it has left its lists' cover mid-pass)
  * keeps this many triangles on the stack. */
 #define DIRECT_STACK 256
@@ -66,6 +71,12 @@ struct wc_collider_contacts {
     double *motion;
     /// Exact tests of feature pairs run so far.
     int64_t feature_tests;
+    /// Whether the last resolve found the cloth apart from every collider
+    /// (cloth_apart) and ran no pass: the candidates are then forgotten,
+    /// made again when it comes near. use_apart: the test switch; how many
+    /// resolves were skipped so.
+    int apart, use_apart;
+    int64_t apart_steps;
 };
 
 /* ------------------------------------------------------------------------ */
@@ -149,6 +160,7 @@ wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *c)
     if (!s) return NULL;
     size_t n = (size_t)c->particle_count;
     s->use_filter = 1;
+    s->use_apart = 1;
     s->el.particle_count = c->particle_count;
     s->el.triangle_count = c->topology.triangle_count;
     s->el.triangles = c->topology.triangles;
@@ -202,6 +214,10 @@ void wci_collider_contacts_commit(wc_collider_contacts *s, int32_t particle_coun
 void wci_collider_contacts_use_filter(wc_collider_contacts *s, int use) { s->use_filter = use; }
 
 void wci_collider_contacts_use_local_motion(wc_collider_contacts *s, int use) { s->whole_collider = !use; }
+
+void wci_collider_contacts_use_apart(wc_collider_contacts *s, int use) { s->use_apart = use; }
+
+int64_t wci_collider_contacts_apart_steps(const wc_collider_contacts *s) { return s->apart_steps; }
 
 int64_t wci_collider_contacts_feature_tests(const wc_collider_contacts *s) { return s->feature_tests; }
 
@@ -926,18 +942,78 @@ static wc_status pass_rounds(wc_collider_contacts *s, wc_cloth *c, const wc_part
     return WC_OK;
 }
 
+/* Whether the boxes are farther apart than r along some axis. */
+static int boxes_apart(const double a[6], const double b[6], double r)
+{
+    for (int k = 0; k < 3; ++k)
+        if (a[k] - b[k + 3] > r || b[k] - a[k + 3] > r) return 1;
+    return 0;
+}
+
+/* Whether the box of every particle's start and end (as it is now) is
+ * farther from every collider's bounds (over the step) than `slack` times
+ * the contact distance: then no particle's path, and no triangle or edge of
+ * the cloth at any time of the step (a convex combination of particles),
+ * comes within the contact distance of any collider feature, and nothing
+ * can touch. A falling cloth or one far from every collider then costs
+ * the stage one pass over its particles. A non-finite position is never
+ * apart. */
+static int cloth_apart(const wc_cloth *c, const wc_particle_arrays *p, wc_collider *const *colliders,
+                       int32_t count, double slack)
+{
+    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        double q[6] = {p->x[i], p->y[i], p->z[i], p->nx[i], p->ny[i], p->nz[i]};
+        for (int j = 0; j < 6; ++j) {
+            if (!isfinite(q[j])) return 0;
+            if (q[j] < box[j % 3]) box[j % 3] = q[j];
+            if (q[j] > box[j % 3 + 3]) box[j % 3 + 3] = q[j];
+        }
+    }
+    for (int32_t k = 0; k < count; ++k)
+        if (!boxes_apart(box, colliders[k]->bounds, slack * contact_distance(c, colliders[k]))) return 0;
+    return 1;
+}
+
+/* The stage over every particle: their motions noted, the lists made or
+ * brought up to date, the passes. */
+static wc_status whole_stage(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
+                             wc_collider *const *colliders, int32_t count, int32_t steps_left,
+                             int threads, wc_step_stats *stats)
+{
+    for (int32_t i = 0; i < c->particle_count; ++i) track(s, p, i);
+    memset(s->changed, 0, (size_t)c->particle_count);
+    if (refresh_candidates(s, c, colliders, count, p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
+    int32_t failsafe = 0;
+    wc_status status = pass_rounds(s, c, p, colliders, count, steps_left, threads, 1, NULL, &failsafe);
+    stats->failsafe_particles += failsafe;
+    return status;
+}
+
 wc_status wci_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
                                        wc_collider *const *colliders, int32_t count,
                                        int32_t steps_left, int threads, wc_step_stats *stats)
 {
     if (count <= 0) return WC_OK;
     wc_particle_arrays p = wci_particle_arrays_of(c);
-    for (int32_t i = 0; i < c->particle_count; ++i) track(s, &p, i);
-    if (refresh_candidates(s, c, colliders, count, &p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
-    int32_t failsafe = 0;
-    wc_status status = pass_rounds(s, c, &p, colliders, count, steps_left, threads, 1, NULL, &failsafe);
-    stats->failsafe_particles += failsafe;
-    return status;
+    /* Apart by more than twice the contact distance to become apart, by more
+     * than it to stay so: a cloth moving about that distance from a
+     * collider does not make its lists again at every step. (A little over
+     * 1 covers the rounding of the box's differences.) */
+    s->apart = s->use_apart && cloth_apart(c, &p, colliders, count, s->apart ? APART_STAYS : APART_BECOMES);
+    if (!s->apart) return whole_stage(s, c, &p, colliders, count, steps_left, threads, stats);
+    /* lists that no step keeps up to date: made again when it comes near */
+    for (int32_t k = 0; k < s->cand_count; ++k) s->cand[k].r = 0.0;
+    ++s->apart_steps;
+    return WC_OK;
+}
+
+/* *changed: the state's flags if any is set, else NULL. */
+static void changed_flags(const wc_collider_contacts *s, int32_t n, const uint8_t **changed)
+{
+    *changed = NULL;
+    for (int32_t i = 0; i < n && !*changed; ++i)
+        if (s->changed[i]) *changed = s->changed;
 }
 
 wc_status wci_collider_contacts_recheck(wc_cloth *c, wc_collider_contacts *s,
@@ -948,6 +1024,15 @@ wc_status wci_collider_contacts_recheck(wc_cloth *c, wc_collider_contacts *s,
     *changed = NULL;
     if (count <= 0) return WC_OK;
     wc_particle_arrays p = wci_particle_arrays_of(c);
+    if (s->apart) {
+        /* resolve ran no pass; if what moved the particles brought the
+         * cloth near a collider, the whole stage runs now */
+        if (cloth_apart(c, &p, colliders, count, APART_STAYS)) return WC_OK;
+        s->apart = 0;
+        wc_status status = whole_stage(s, c, &p, colliders, count, steps_left, threads, stats);
+        changed_flags(s, c->particle_count, changed);
+        return status;
+    }
     int any = 0;
     for (int32_t i = 0; i < c->particle_count; ++i)
         if (moved[i]) track(s, &p, i), s->recheck[i] = 1, any = 1;
@@ -956,7 +1041,6 @@ wc_status wci_collider_contacts_recheck(wc_cloth *c, wc_collider_contacts *s,
     int32_t failsafe = 0;
     wc_status status = pass_rounds(s, c, &p, colliders, count, steps_left, threads, 0, moved, &failsafe);
     stats->failsafe_particles += failsafe;
-    for (int32_t i = 0; i < c->particle_count && !*changed; ++i)
-        if (s->changed[i]) *changed = s->changed;
+    changed_flags(s, c->particle_count, changed);
     return status;
 }

@@ -59,9 +59,6 @@ wc_status wci_collider_contacts_recheck(wc_cloth *cloth, wc_collider_contacts *s
                                        const uint8_t *moved, int32_t steps_left, int threads,
                                        wc_step_stats *stats, const uint8_t **changed);
 
-/// Test switch: 1 (default) skips the pairs the filter proves apart, 0
-/// gives every listed pair the exact test. The results are the same bit for
-/// bit; tests compare the two.
 /// After a committed step: the candidates' local paths take the step's
 /// local motion (candidates.h).
 void wci_collider_contacts_commit(wc_collider_contacts *state, int32_t particle_count);
@@ -71,7 +68,20 @@ void wci_collider_contacts_commit(wc_collider_contacts *state, int32_t particle_
 /// what is near.
 void wci_collider_contacts_use_local_motion(wc_collider_contacts *state, int use);
 
+/// Test switch: 1 (default) skips the pairs the filter proves apart, 0
+/// gives every listed pair the exact test. The results are the same bit for
+/// bit; tests compare the two.
 void wci_collider_contacts_use_filter(wc_collider_contacts *state, int use);
+
+/// Test switch: 1 (default) skips the whole stage for a step in which the
+/// box of the cloth's particles (start and end) is farther than twice the
+/// contact distance from every collider's bounds (a falling cloth, one far
+/// from every collider), and forgets the lists, made again when it comes
+/// near; 0 runs the stage at every step. The same bits either way.
+void wci_collider_contacts_use_apart(wc_collider_contacts *state, int use);
+
+/// How many resolves the stage has skipped so (tests).
+int64_t wci_collider_contacts_apart_steps(const wc_collider_contacts *state);
 
 /// How many exact tests of feature pairs (collider vertex against cloth
 /// triangle, collider edge against cloth edge) the stage has run so far:
