@@ -945,8 +945,8 @@ double wci_candidates_displacement(const wc_candidates *c, const wc_particle_arr
     return sqrt(farthest2_over_step(c, p, i, c->base + 3 * (size_t)i));
 }
 
-double wci_pair_lists_drift(const wc_candidates *c, const wc_pair_lists *l, int32_t k,
-                           const int32_t *particles, const wc_particle_arrays *p)
+double wci_pair_lists_drift2(const wc_candidates *c, const wc_pair_lists *l, int32_t k,
+                            const int32_t *particles, const wc_particle_arrays *p)
 {
     const double *snap = l->snap + 3 * (size_t)l->per * (size_t)k;
     double most2 = 0.0;
@@ -954,7 +954,13 @@ double wci_pair_lists_drift(const wc_candidates *c, const wc_pair_lists *l, int3
         double d2 = farthest2_over_step(c, p, particles[j], snap + 3 * j);
         if (d2 > most2) most2 = d2;
     }
-    return sqrt(most2);
+    return most2;
+}
+
+double wci_pair_lists_drift(const wc_candidates *c, const wc_pair_lists *l, int32_t k,
+                           const int32_t *particles, const wc_particle_arrays *p)
+{
+    return sqrt(wci_pair_lists_drift2(c, l, k, particles, p));
 }
 
 double wci_pair_lists_end_drift(const wc_candidates *c, const wc_pair_lists *l, int32_t k,

@@ -279,6 +279,12 @@ wc_status wci_candidates_rebase(wc_candidates *cand, const wc_cloth_elements *el
 double wci_pair_lists_drift(const wc_candidates *cand, const wc_pair_lists *l, int32_t k,
                            const int32_t *particles, const wc_particle_arrays *p);
 
+/// Its square, without the root: a caller that only compares it with a
+/// bound compares squares (the root's latency held up the feature pass'
+/// quick way out of most visits).
+double wci_pair_lists_drift2(const wc_candidates *cand, const wc_pair_lists *l, int32_t k,
+                            const int32_t *particles, const wc_particle_arrays *p);
+
 /// How far owner k's particles' ends are from where they were at its
 /// snapshot, each in its frame.
 double wci_pair_lists_end_drift(const wc_candidates *cand, const wc_pair_lists *l, int32_t k,

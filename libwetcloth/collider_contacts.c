@@ -542,15 +542,17 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
             if (kept != stack) wci_free(kept);
             kept = grown, room = l->count[i];
         }
-        double near = wci_pair_lists_drift(cand, l, i, &i, p);
-        double reach = r + near + drift + l->debt[i] + FILTER_EPSILON(r), rest;
+        double near2 = wci_pair_lists_drift2(cand, l, i, &i, p);
         /* nothing in the list can touch (the hanging part of a draped
          * cloth): no scan, and the old snapshot kept, whose bound is the
-         * displacement from it rather than the path since */
-        if (use_filter && after < 0 && l->least[i] > reach) {
+         * displacement from it rather than the path since; least > reach
+         * compared on squares, as in visit_element */
+        double clear = l->least[i] - (r + drift + l->debt[i] + FILTER_EPSILON(r));
+        if (use_filter && after < 0 && clear > 0.0 && clear * clear > near2) {
             m.complete = 0;
             break;
         }
+        double reach = r + sqrt(near2) + drift + l->debt[i] + FILTER_EPSILON(r), rest;
         int32_t n = survivors(l, i, reach, !use_filter, after, kept, &rest);
         if (rest < m.rest) m.rest = rest;
         if (n == 0) break;
@@ -748,9 +750,15 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
     const wc_pair_lists *l = kind->lists;
     const wc_candidates *cand = &s->cand[k];
     double reach = feature_reach(r) + FILTER_EPSILON(r);
+    /* nothing in the list can touch: the cheap way out of most visits,
+     * least - debt - path - drift > reach compared on squares (the filter's
+     * epsilon is far above the rounding by which the two forms differ) */
+    double path = wc_candidates_path_now(cand, idx[0]) - l->path_at[e];
+    double clear = l->least[e] - l->debt[e] - path - reach;
+    if (!s->use_filter ? l->count[e] == 0
+                       : clear > 0.0 && clear * clear > wci_pair_lists_drift2(cand, l, e, idx, p))
+        return 0;
     double drift = element_drift(cand, l, e, idx, p);
-    /* nothing in the list can touch: the cheap way out of most visits */
-    if (!s->use_filter ? l->count[e] == 0 : l->least[e] - l->debt[e] - drift > reach) return 0;
     double mu = sqrt(c->material.friction * col->friction), rest = INFINITY;
     int32_t after = -1, n = 0;
     int pushed = 0;
