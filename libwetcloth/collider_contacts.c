@@ -754,11 +754,10 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
      * least - debt - path - drift > reach compared on squares (the filter's
      * epsilon is far above the rounding by which the two forms differ) */
     double path = wc_candidates_path_now(cand, idx[0]) - l->path_at[e];
+    double most2 = wci_pair_lists_drift2(cand, l, e, idx, p);
     double clear = l->least[e] - l->debt[e] - path - reach;
-    if (!s->use_filter ? l->count[e] == 0
-                       : clear > 0.0 && clear * clear > wci_pair_lists_drift2(cand, l, e, idx, p))
-        return 0;
-    double drift = element_drift(cand, l, e, idx, p);
+    if (!s->use_filter ? l->count[e] == 0 : clear > 0.0 && clear * clear > most2) return 0;
+    double drift = sqrt(most2) + path; /* element_drift, from what is at hand */
     double mu = sqrt(c->material.friction * col->friction), rest = INFINITY;
     int32_t after = -1, n = 0;
     int pushed = 0;

@@ -909,9 +909,15 @@ static void ground_vertices(double flap, double bump, double rise, double *v)
         }
 }
 
-static int64_t deforming_ground(ground_run run, uint64_t *hash)
+/* The ground's vertices (ground_vertices writes them; a test gives them to
+ * the collider as it deforms it). */
+static double ground_v[3 * (GROUND_N + 1) * (GROUND_N + 1)];
+enum { GROUND_VERTICES = (GROUND_N + 1) * (GROUND_N + 1) };
+
+/* A world (1 thread) with the ground at rest (collider thickness 0.02 m) and
+ * a 16 x 16 cloth of 0.5 m 5 cm above it: their indices in *col and *cl. */
+static wc_world *ground_world(int32_t *col, int32_t *cl)
 {
-    static double v[3 * (GROUND_N + 1) * (GROUND_N + 1)];
     static int32_t t[6 * GROUND_N * GROUND_N];
     int32_t nt = 0;
     for (int j = 0; j < GROUND_N; ++j)
@@ -923,24 +929,30 @@ static int64_t deforming_ground(ground_run run, uint64_t *hash)
     wc_world_def def = wc_world_def_default();
     def.thread_count = 1;
     wc_world *w = scene_world_from(&def);
-    ground_vertices(0.0, 0.0, 0.0, v);
+    ground_vertices(0.0, 0.0, 0.0, ground_v);
     wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertices = v, d.vertex_count = (GROUND_N + 1) * (GROUND_N + 1);
+    d.vertices = ground_v, d.vertex_count = GROUND_VERTICES;
     d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
-    int32_t col, cl;
-    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    CHECK(wc_world_add_mesh_collider(w, &d, col) == WC_OK, "%s", wc_world_last_error(w));
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = 16;
     g.size_u = g.size_v = 0.5;
     g.center[2] = 0.05;
-    CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
+    CHECK(wc_world_add_grid_cloth(w, &g, cl) == WC_OK, "%s", wc_world_last_error(w));
+    return w;
+}
+
+static int64_t deforming_ground(ground_run run, uint64_t *hash)
+{
+    int32_t col, cl;
+    wc_world *w = ground_world(&col, &cl);
     if (run.refuse) w->tear_ratio = 0.0, w->tear_growth = -INFINITY;
     int64_t before = 0;
     for (int f = 0; f < 36; ++f) {
         if (f >= 12) {
             double s = (f - 11) / 24.0;
-            ground_vertices(run.flap * sin(3.0 * (f - 11)), run.bump * s, run.rise * (f - 11), v);
-            CHECK(wc_collider_set_vertices(w, col, v, d.vertex_count) == WC_OK, "%s",
+            ground_vertices(run.flap * sin(3.0 * (f - 11)), run.bump * s, run.rise * (f - 11), ground_v);
+            CHECK(wc_collider_set_vertices(w, col, ground_v, GROUND_VERTICES) == WC_OK, "%s",
                   wc_world_last_error(w));
         }
         advance_or_fail(w, 1.0 / 24, 0);
@@ -1034,35 +1046,15 @@ static void ground_carrying_the_cloth(void)
  * were left outside their cover (measured). */
 static void cover_kept_under_a_fast_bend(void)
 {
-    static double v[3 * (GROUND_N + 1) * (GROUND_N + 1)];
-    static int32_t t[6 * GROUND_N * GROUND_N];
-    int32_t nt = 0;
-    for (int j = 0; j < GROUND_N; ++j)
-        for (int i = 0; i < GROUND_N; ++i) {
-            int32_t a = j * (GROUND_N + 1) + i, b = a + 1, c = a + GROUND_N + 1, d = c + 1;
-            t[3 * nt] = a, t[3 * nt + 1] = b, t[3 * nt + 2] = d, ++nt;
-            t[3 * nt] = a, t[3 * nt + 1] = d, t[3 * nt + 2] = c, ++nt;
-        }
-    wc_world_def def = wc_world_def_default();
-    def.thread_count = 1;
-    wc_world *w = scene_world_from(&def);
-    ground_vertices(0.0, 0.0, 0.0, v);
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertices = v, d.vertex_count = (GROUND_N + 1) * (GROUND_N + 1);
-    d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
     int32_t col, cl;
-    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
-    wc_grid_cloth_def g = wc_grid_cloth_def_default();
-    g.count_u = g.count_v = 16;
-    g.size_u = g.size_v = 0.5;
-    g.center[2] = 0.05;
-    CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
+    wc_world *w = ground_world(&col, &cl);
     for (int f = 0; f < 12; ++f) advance_or_fail(w, 1.0 / 24, 12);
     const int steps = 2 * 12;
     int32_t worst = 0;
     for (int k = 1; k <= steps; ++k) {
-        ground_vertices(0.2 * sin(0.7 * k), 0.1 * k / steps, 0.0, v);
-        CHECK(wc_collider_set_vertices(w, col, v, d.vertex_count) == WC_OK, "%s", wc_world_last_error(w));
+        ground_vertices(0.2 * sin(0.7 * k), 0.1 * k / steps, 0.0, ground_v);
+        CHECK(wc_collider_set_vertices(w, col, ground_v, GROUND_VERTICES) == WC_OK, "%s",
+              wc_world_last_error(w));
         CHECK(wc_world_step(w, 1.0 / 288) == WC_OK, "%s", wc_world_last_error(w));
         int32_t n = wci_collider_contacts_uncovered(w->cloths[cl]->collider_contacts, w->cloths[cl]);
         if (n > worst) worst = n;
