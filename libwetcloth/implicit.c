@@ -711,11 +711,12 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
                        : 0.0;
     solve_pass shared = {pass, bound};
     /* A team only where the particle blocks split too (WC_PARALLEL_MIN
-     * particles): below, every per-particle loop of an iteration ran on the
-     * first thread while the others waited at its barriers, and a
-     * 2,601-particle drape's integration took 61-80 ms per frame on 2 threads
-     * against 43 on 1. */
-    wci_parallel_team(wc_threads_for(pass->state->n, threads), solve_body, &shared);
+     * particles and more than one block): otherwise every per-particle loop
+     * of an iteration runs on the first thread while the others wait at its
+     * barriers (a 2,601-particle drape's integration took 61-80 ms per frame
+     * on 2 threads against 43 on 1 when its blocks did not split). */
+    const wc_implicit_state *s = pass->state;
+    wci_parallel_team(s->blocks > 1 ? wc_threads_for(s->n, threads) : 1, solve_body, &shared);
 }
 
 /* First particle whose right-hand side is not finite, -1 if none. Forces

@@ -7,8 +7,14 @@
 #include <stdint.h>
 
 /// Loops with fewer iterations than this run on one thread: below it, waking
-/// the thread team costs more than the loop itself.
-#define WC_PARALLEL_MIN 4096
+/// the thread team costs about what the loop itself does. At 4096 every
+/// loop of a cloth of a few thousand particles ran on one thread, and 2
+/// threads gained 3-7 % per frame; from 512 the 25 x 25 to 50 x 50 cloths on
+/// the 3,968-triangle sphere (576 to 2,500 particles) take 1.18-1.57 times
+/// less time per frame on 2 threads, and the 400-particle thesis drape no
+/// more (docs/model.md, Cost of a step: measured with
+/// `build/tools/bench_contacts scene=sphere64 size=N threads=1|2 adapt=0`).
+#define WC_PARALLEL_MIN 512
 
 /// Threads to use for a world's thread_count setting (0 = OpenMP default).
 int wci_thread_count(int requested);

@@ -53,8 +53,9 @@
  * and its first step's forces took 1.6-1.9 times one thread's on an idle
  * machine, where later steps take 0.6-0.8 times (design-notes.md). Only
  * stages of at least EARLY_MIN_SECONDS on the chosen count are compared:
- * a cloth whose forces are shorter runs them on one thread anyway (below
- * WC_PARALLEL_MIN particles), so they say nothing about the count. */
+ * a cloth whose forces are shorter (a few hundred particles: its loops
+ * barely split, or not at all below WC_PARALLEL_MIN) says nothing about
+ * the count there. */
 #define EARLY_ABANDON 1.25
 #define EARLY_MIN_SECONDS 5e-4
 /* Cheaper than any lost probe is one not run: a probe of more threads

@@ -454,8 +454,9 @@ static uint64_t sphere_drop_hash(int32_t threads)
  * sphere of Blender's collider thickness, 0.02 m: the candidates' lists,
  * made on the world's threads in several batches (about 24,000 of them at
  * the first step), their rebases and the parallel particle pass with many
- * pairs per particle. */
-static uint64_t thick_drop_hash(int32_t threads)
+ * pairs per particle. `side` 64, or 25: 625 particles, above
+ * WC_PARALLEL_MIN but in two unequal blocks of the solve's sums. */
+static uint64_t thick_drop_hash(int32_t threads, int32_t side)
 {
     wc_world_def def = wc_world_def_default();
     def.thread_count = threads;
@@ -469,12 +470,12 @@ static uint64_t thick_drop_hash(int32_t threads)
     d.vertices = v, d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
     CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
-    g.count_u = g.count_v = 64;
+    g.count_u = g.count_v = side;
     g.center[2] = 0.33; /* within the contact distance of the top at once */
     int32_t cl;
     CHECK(wc_world_add_grid_cloth(w, &g, &cl) == WC_OK, "%s", wc_world_last_error(w));
     for (int f = 0; f < 3; ++f) advance_or_fail(w, 1.0 / 24, 0);
-    CHECK(wc_world_get_stats(w).collider_contacts > 100, "only %d contacts with %d threads",
+    CHECK(wc_world_get_stats(w).collider_contacts > side * side / 16, "only %d contacts with %d threads",
           (int)wc_world_get_stats(w).collider_contacts, threads);
     uint64_t h = scene_hash_positions(w, cl);
     wc_world_destroy(w);
@@ -564,10 +565,16 @@ static void determinism(void)
     printf("collision determinism: %016llx %016llx %016llx\n", (unsigned long long)h1,
            (unsigned long long)h2, (unsigned long long)h4);
     CHECK(h1 == h2 && h1 == h4, "hashes differ across thread counts");
-    uint64_t t1 = thick_drop_hash(1), t2 = thick_drop_hash(2), t4 = thick_drop_hash(4);
-    printf("collision determinism, implicit, 0.02 m on 3,968 triangles: %016llx %016llx %016llx\n",
-           (unsigned long long)t1, (unsigned long long)t2, (unsigned long long)t4);
-    CHECK(t1 == t2 && t1 == t4, "hashes differ across thread counts (thick collider)");
+    const int32_t sides[2] = {64, 25};
+    for (int k = 0; k < 2; ++k) {
+        int32_t side = sides[k];
+        uint64_t t1 = thick_drop_hash(1, side), t2 = thick_drop_hash(2, side), t4 = thick_drop_hash(4, side);
+        printf("collision determinism, implicit, %d x %d cloth, 0.02 m on 3,968 triangles: "
+               "%016llx %016llx %016llx\n", (int)side, (int)side, (unsigned long long)t1,
+               (unsigned long long)t2, (unsigned long long)t4);
+        CHECK(t1 == t2 && t1 == t4, "hashes differ across thread counts (thick collider, %d x %d)",
+              (int)side, (int)side);
+    }
 }
 
 /* The candidates' filter (candidates.h) only skips pairs it proves cannot

@@ -1,7 +1,7 @@
 /* Determinism: the same input gives bitwise the same output for
  * any number of threads, and for repeated runs.
  *
- * Scene: a 64 x 64 cloth (4096 particles: at WC_PARALLEL_MIN, so the
+ * Scene: a 64 x 64 cloth (4096 particles: above WC_PARALLEL_MIN, so the
  * per-particle loops run in parallel too, not only the ~16k-link loops),
  * crumpled by a random perturbation from a fixed seed so that many bend
  * links are compressed, the two top corners pinned, default material

@@ -307,7 +307,8 @@ static void stiff(void)
 /* ------------------------------------------------------------------------ */
 
 /* A 65 x 65 wet cloth (4225 particles: every loop over particles and links
- * is above WC_PARALLEL_MIN = 4096 and runs in parallel) draped from just
+ * is above WC_PARALLEL_MIN and runs in parallel, and the implicit
+ * integrator's coarse levels are built) draped from just
  * above the thesis sphere, pinned at one corner, several steps of 1/120 s.
  * The same hash for 1, 2 and 4 threads. */
 static void determinism(void)

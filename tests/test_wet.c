@@ -893,8 +893,8 @@ static void wet_grip(void)
 /* 5d. Thread count                                                         */
 /* ------------------------------------------------------------------------ */
 
-/* A soaked 64 x 64 cloth (4096 particles: the size at which the per-particle
- * loops, the contact hold among them, run in parallel) lies 4 mm above a
+/* A soaked 64 x 64 cloth (4096 particles: above the size at which the
+ * per-particle loops, the contact hold among them, run in parallel) lies 4 mm above a
  * floor plate (within the contact distance) and is kicked upward in a wave,
  * v_z = 0.5 sin(7 x) cos(5 y) m/s, so parts of it leave the floor and come
  * back, keep or lose their held contacts: 100 steps at 0.9 of the stable
