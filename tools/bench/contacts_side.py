@@ -22,7 +22,10 @@ without the program runs this one against its library, through
 LD_LIBRARY_PATH), each at its library's default integrator and steps,
 alternated --reps times; figures are given as ranges over the repetitions. Collider
 thickness 0.02 m (Blender's Collision modifier default, which the add-on
-passes on), friction 0.5, 1 thread.
+passes on), friction 0.5, 1 thread. This build also runs at the default
+thread count (threads=0: every core, the world's adaptive count on, as a
+user gets it), once per repetition, so that the figure a user sees stands
+next to the 1-thread one (the base build and the references run on 1).
 
 Blender: the same geometry (the collider from the same vertex arrays, the
 cloth the same grid of quads), the Cloth modifier's defaults and quality 5,
@@ -310,13 +313,15 @@ def main():
             extra += ["integrator=xpbd", "steps=12"]
         if carry:
             extra.append(f"carry={carry}")
-        new_runs, base_runs = [], []
+        new_runs, base_runs, default_runs = [], [], []
         for rep in range(a.reps):
             if base_lib and not carry:
                 bf = a.base_frames or a.frames
                 base_runs.append(ours(base_program, base_lib, scene, bf, extra))
             new_runs.append(ours(program, build_lib, scene, a.frames, extra,
                                  out=os.path.join(tmp, "new.bin") if rep == 0 else None))
+            default_runs.append(ours(program, build_lib, scene, a.frames,
+                                     [e for e in extra if not e.startswith("threads=")] + ["threads=0"]))
         err = None
         if not a.no_error:
             steps = int(round(new_runs[0]["substeps_per_frame"]))
@@ -327,7 +332,8 @@ def main():
             err = rms(read_positions(os.path.join(tmp, "new.bin"), n * n),
                       read_positions(os.path.join(tmp, "ref.bin"), n * n), width)
             ref_ok = ref["finite"]
-        row = {"scene": item, "ours": new_runs, "base": base_runs, "error": err}
+        row = {"scene": item, "ours": new_runs, "base": base_runs, "default_threads": default_runs,
+               "error": err}
         if not a.no_blender:
             key = (scene, self_c, carry)
             if key not in blender_cache:
@@ -348,7 +354,8 @@ def main():
         line = (f"{item}: ours {span(ms)} ms/frame (collide {span([r['collide_ms_per_frame'] for r in new_runs])}), "
                 f"{new_runs[0]['substeps_per_frame']:.3g} steps/frame, error {err if err is None else f'{err:.2e}'}, "
                 f"intersections {new_runs[0]['intersections_last']}, highest {new_runs[0]['highest_after_landing']:.3f}"
-                f"/{new_runs[0]['start_height']:.3f}, longest link {new_runs[0]['longest_link']:.3f}")
+                f"/{new_runs[0]['start_height']:.3f}, longest link {new_runs[0]['longest_link']:.3f}; "
+                f"default threads {span([r['ms_per_frame'] for r in default_runs])} ms/frame")
         if base_runs:
             line += (f"; base {span([r['ms_per_frame'] for r in base_runs])} ms/frame (collide "
                      f"{span([r['collide_ms_per_frame'] for r in base_runs])}), {base_runs[0]['substeps_per_frame']:.3g} "
@@ -363,9 +370,10 @@ def main():
     print()
     print("| scene | ours ms/frame | ours collide ms | steps/frame | our error | before ms/frame "
           "| before collide ms | collide before / ours | Blender q5 ms | Blender q5 / ours "
-          "| Blender at equal error / ours | intersections ours, before | highest / start, ours "
+          "| Blender at equal error / ours | ours ms/frame, default threads "
+          "| Blender q5 / ours, default threads | intersections ours, before | highest / start, ours "
           "| longest link ours, before, Blender |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for row in rows:
         o, b = row["ours"], row["base"]
         oms = [r["ms_per_frame"] for r in o]
@@ -376,6 +384,8 @@ def main():
         bl = row.get("blender")
         q5 = span([1e3 * s for s in bl["q5_s"]]) if bl else "-"
         q5r = span([1e3 * s / y for s in bl["q5_s"] for y in oms], "{:.2f}") if bl else "-"
+        dms = [r["ms_per_frame"] for r in row["default_threads"]]
+        q5d = span([1e3 * s / y for s in bl["q5_s"] for y in dms], "{:.2f}") if bl else "-"
         eq = "-"
         if bl and bl["sweep"] and row["error"] is not None:
             ok = [(w, q) for q, (w, e) in bl["sweep"].items() if e <= row["error"]]
@@ -392,7 +402,7 @@ def main():
         error_text = "-" if row["error"] is None else f"{row['error']:.2e}"
         print(f"| {row['scene']} | {span(oms)} | {span(ocol)} | {o[0]['substeps_per_frame']:.3g} | "
               f"{error_text} | "
-              f"{span(bms)} | {span(bcol)} | {ratio_collide} | {q5} | {q5r} | {eq} | "
+              f"{span(bms)} | {span(bcol)} | {ratio_collide} | {q5} | {q5r} | {eq} | {span(dms)} | {q5d} | "
               f"{o[0]['intersections_last']}, {b[0]['intersections_last'] if b else '-'} | "
               f"{o[0]['highest_after_landing']:.3f} / {o[0]['start_height']:.3f} | "
               f"{o[0]['longest_link']:.2f}, {format(b[0]['longest_link'], '.2f') if b else '-'}, "

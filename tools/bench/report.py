@@ -546,7 +546,8 @@ def contacts(out, quick, python, build, base, lines):
     lines += [
         "Grid cloths falling onto mesh colliders with Blender's default collider thickness (0.02 m) "
         "and friction 0.5, 24 frames of 1/24 s, 1 thread for ours (Blender uses its own thread "
-        "pool on the same cores); each library at its own default integrator and steps unless the "
+        "pool on the same cores), and ours again at the default thread count (every core, the "
+        "adaptive count on: what a user gets; \"default threads\"); each library at its own default integrator and steps unless the "
         "scene says +xpbd12 (both at XPBD, 12 steps per frame). +carry: from the middle frame on "
         "the collider moves along x at 0.5 m/s, carrying the cloth draped on it (in Blender the "
         "collider object's location); the build before does not run these. "
