@@ -64,8 +64,9 @@ sys.path.insert(0, HERE)
 # every barrier of a 2-thread step for a scheduler tick (measured: 0.1 s per
 # step of a 4096-particle cloth at load 8, 2 threads, against 0.5 ms with 1).
 # The sections that measure what a user gets on several threads (Blender side
-# by side, threads under load) run their programs with the policy this
-# program was started with (user_env), the library's default unless set.
+# by side, the contact stage's default threads, threads under load) run their
+# programs with the policy this program was started with (user_env), the
+# library's default unless set.
 USER_WAIT_POLICY = os.environ.get("OMP_WAIT_POLICY")
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
@@ -540,14 +541,15 @@ def contacts(out, quick, python, build, base, lines):
         cmd += ["--base", base, "--base-frames", "12"]
     if quick:
         cmd += ["--scenes", "thesis", "--frames", "4", "--reps", "1", "--sweep", "2"]
-    r = subprocess.run(cmd, capture_output=True, text=True)
+    r = subprocess.run(cmd, capture_output=True, text=True, env=user_env())
     if r.returncode != 0:
         raise SystemExit("contacts_side.py failed:\n" + r.stdout[-3000:] + r.stderr[-3000:])
     lines += [
         "Grid cloths falling onto mesh colliders with Blender's default collider thickness (0.02 m) "
         "and friction 0.5, 24 frames of 1/24 s, 1 thread for ours (Blender uses its own thread "
         "pool on the same cores), and ours again at the default thread count (every core, the "
-        "adaptive count on: what a user gets; \"default threads\"); each library at its own default integrator and steps unless the "
+        "adaptive count on, the user's OpenMP wait policy: what a user gets; \"default "
+        "threads\"); each library at its own default integrator and steps unless the "
         "scene says +xpbd12 (both at XPBD, 12 steps per frame). +carry: from the middle frame on "
         "the collider moves along x at 0.5 m/s, carrying the cloth draped on it (in Blender the "
         "collider object's location); the build before does not run these. "
