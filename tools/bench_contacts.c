@@ -35,8 +35,8 @@
  * bend (1: the cylinder's ends rise; 0: it stays straight), carry (m/s, 0:
  * from the middle frame of the run on, the collider moves along x at that
  * speed, carrying the cloth that rests on it), trace (1: one
- * line per frame on stderr: wall and collide ms, longest link, fail-safe
- * particles, intersections when counted).
+ * line per frame on stderr: wall and collide ms, the threads of its last
+ * step, longest link, fail-safe particles, intersections when counted).
  *
  * Printed: ms per frame (wall), collision ms per frame (the library's
  * collide phase), substeps per frame, intersections (all, and cloth against
@@ -357,11 +357,12 @@ int main(int argc, char **argv)
             if (last_intersections > worst_intersections) worst_intersections = last_intersections;
         }
         if (o.trace)
-            fprintf(stderr, "frame %d: %.1f ms (collide %.1f, integrate %.1f, %lld solver iterations), "
+            fprintf(stderr, "frame %d: %.1f ms (collide %.1f, integrate %.1f, %lld solver iterations, "
+                            "last step on %d threads), "
                             "longest link %.3f, fail-safe %lld, halved steps %d, intersections %d "
                             "(with the collider %d)\n",
                     f, 1e3 * frame_seconds, 1e3 * stats.collide_seconds, 1e3 * stats.integrate_seconds,
-                    (long long)stats.solver_iterations,
+                    (long long)stats.solver_iterations, (int)stats.threads,
                     longest, (long long)stats.failsafe_particles, frame_halved,
                     o.check == 2 ? last_intersections : -1, o.check == 2 ? last_collider : -1);
     }
