@@ -547,12 +547,13 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
          * cloth): no scan, and the old snapshot kept, whose bound is the
          * displacement from it rather than the path since; least > reach
          * compared on squares, as in visit_element */
-        double clear = l->least[i] - (r + drift + l->debt[i] + FILTER_EPSILON(r));
+        double still = r + drift + l->debt[i] + FILTER_EPSILON(r); /* the reach less near */
+        double clear = l->least[i] - still;
         if (use_filter && after < 0 && clear > 0.0 && clear * clear > near2) {
             m.complete = 0;
             break;
         }
-        double reach = r + sqrt(near2) + drift + l->debt[i] + FILTER_EPSILON(r), rest;
+        double reach = still + sqrt(near2), rest;
         int32_t n = survivors(l, i, reach, !use_filter, after, kept, &rest);
         if (rest < m.rest) m.rest = rest;
         if (n == 0) break;

@@ -143,18 +143,18 @@ static int moving_triangle_apart(const wc_collider *c, int32_t t, const double s
 
 /* For a static triangle the particle stays on one side of all the step
  * (no crossing, so only the distance at the end can answer): whether that
- * distance is no touch, with its square in *end_d2, as the full test would
- * leave it. Spares the test's contact geometry for the many triangles
- * that lie within reach of a resting particle but do not touch it (the
- * slivers at a UV sphere's pole). */
-static int static_apart(const wc_collider *c, int32_t t, const double end[3], double r, double *end_d2)
+ * distance is no touch. Its square goes to *d2 and its closest point's
+ * weights to w either way, as the full test computes them, so that a
+ * triangle that does touch goes on from them. Spares the test's contact
+ * geometry for the many triangles that lie within reach of a resting
+ * particle but do not touch it (the slivers at a UV sphere's pole). */
+static int static_apart(const wc_collider *c, int32_t t, const double end[3], double r, double *d2,
+                        double w[3])
 {
-    double e[3][3], w[3];
+    double e[3][3];
     for (int k = 0; k < 3; ++k) vertex_of(c->next, c->triangles[3 * (size_t)t + k], e[k]);
-    double d2 = wci_point_triangle_closest(end, e[0], e[1], e[2], w);
-    if (d2 < r * r * (1.0 - 1e-9)) return 0;
-    *end_d2 = d2;
-    return 1;
+    *d2 = wci_point_triangle_closest(end, e[0], e[1], e[2], w);
+    return !(*d2 < r * r * (1.0 - 1e-9));
 }
 
 int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particle,
@@ -162,6 +162,8 @@ int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t partic
                                 double *end_d2, wc_contact *out)
 {
     double t0[3][3], t1[3][3], n0[3], n1[3];
+    double w[3], cp[3], offset[3], tc, d2 = 0.0;
+    int measured = 0; /* d2 and w hold the end's distance already */
     *end_d2 = 0.0;
     if (!c->moving) {
         /* Cheap rejection for a static triangle: the particle stays on one
@@ -175,9 +177,14 @@ int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t partic
             *end_d2 = de * de;
             return 0;
         }
-        if (ds * de > 0.0 && static_apart(c, t, end, r, end_d2)) return 0;
+        if (ds * de > 0.0) {
+            measured = 1;
+            if (static_apart(c, t, end, r, &d2, w)) {
+                *end_d2 = d2;
+                return 0;
+            }
+        }
     }
-    double w[3], cp[3], offset[3], tc, d2 = 0.0;
     if (c->moving) {
         int apart = moving_triangle_apart(c, t, start, end, r, &d2, w);
         if (apart < 0) return 0;
@@ -186,7 +193,7 @@ int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t partic
     }
     triangle_motion(c, t, t0, t1, n0, n1);
     if (n1[0] == 0.0 && n1[1] == 0.0 && n1[2] == 0.0) return 0;
-    if (!c->moving) d2 = wci_point_triangle_closest(end, t1[0], t1[1], t1[2], w);
+    if (!c->moving && !measured) d2 = wci_point_triangle_closest(end, t1[0], t1[1], t1[2], w);
     *end_d2 = d2;
     bary_point(t1[0], t1[1], t1[2], w, cp);
     for (int k = 0; k < 3; ++k) offset[k] = end[k] - cp[k];
