@@ -274,13 +274,15 @@ static int32_t query(wc_list_maker *m, const wc_bvh *bvh, const double box[6])
     return wci_bvh_collect(bvh, box, m->found, m->found_capacity);
 }
 
-/* Room for n entries and as many again behind them (the sort's). */
-static pair_entry *entries(wc_list_maker *m, int64_t n)
+/* Room for n entries and as many again behind them (the sort's), the
+ * first `keep` kept. */
+static pair_entry *entries(wc_list_maker *m, int64_t n, int64_t keep)
 {
     if (m->entries && 2 * n <= m->entry_capacity) return m->entries;
     int64_t want = 2 * (2 * n + 64);
     pair_entry *e = wci_alloc_array((size_t)want, sizeof *e);
     if (!e) return NULL;
+    if (keep) memcpy(e, m->entries, (size_t)keep * sizeof *e);
     wci_free(m->entries);
     m->entries = e, m->entry_capacity = want;
     return e;
@@ -363,7 +365,7 @@ static int particle_pairs(const wc_candidates *c, wc_list_maker *m, const wc_col
     for (int k = 0; k < 3; ++k) box[k] = p[k] - reach, box[k + 3] = p[k] + reach;
     int32_t n = query(m, &col->bvh, box);
     if (n < 0) return 0;
-    pair_entry *e = entries(m, n);
+    pair_entry *e = entries(m, n, 0);
     if (!e) return 0;
     int32_t kept = 0;
     for (int32_t k = 0; k < n; ++k) {
@@ -380,20 +382,25 @@ static int triangle_pairs(const wc_candidates *c, wc_list_maker *m, const wc_clo
                           const wc_collider *col, wc_list_job *job)
 {
     const int32_t *idx = el->triangles + 3 * (size_t)job->owner;
-    double reach = c->feature_r + element_margin(c, idx, 3), box[6], a[3], b[3], d[3];
-    element_box(c, idx, 3, reach, box);
-    int32_t n = query(m, &col->vertex_bvh, box);
-    if (n < 0) return 0;
-    pair_entry *e = entries(m, n);
-    if (!e) return 0;
+    double margin = element_margin(c, idx, 3), a[3], b[3], d[3];
     base_of(c, idx[0], a), base_of(c, idx[1], b), base_of(c, idx[2], d);
     int32_t kept = 0;
-    for (int32_t k = 0; k < n; ++k) {
-        int32_t v = col->used_vertices[m->found[k]];
-        double p[3], w[3];
-        vertex_of(col->current, v, p);
-        double dist = sqrt(wci_point_triangle_closest(p, a, b, d, w));
-        if (dist <= reach) e[kept].d0 = dist, e[kept].item = v, ++kept;
+    pair_entry *e = NULL;
+    /* the sharp vertices, then the smooth ones (collider.h) */
+    for (int smooth = 0; smooth < 2; ++smooth) {
+        double r = smooth && c->smooth_features ? c->feature_r : c->feature_r + c->sharp_shift;
+        double reach = r + margin, shift = smooth ? 0.0 : c->sharp_shift, box[6];
+        element_box(c, idx, 3, reach, box);
+        int32_t n = query(m, smooth ? &col->smooth_vertex_bvh : &col->vertex_bvh, box);
+        if (n < 0 || !(e = entries(m, kept + n, kept))) return 0;
+        const int32_t *vertex = col->used_vertices + (smooth ? col->smooth_vertices_from : 0);
+        for (int32_t k = 0; k < n; ++k) {
+            int32_t v = vertex[m->found[k]];
+            double p[3], w[3];
+            vertex_of(col->current, v, p);
+            double dist = sqrt(wci_point_triangle_closest(p, a, b, d, w));
+            if (dist <= reach) e[kept].d0 = dist - shift, e[kept].item = v, ++kept;
+        }
     }
     return keep_sorted(m, job, e, kept);
 }
@@ -426,24 +433,30 @@ static int edge_pairs(const wc_candidates *c, wc_list_maker *m, const wc_cloth_e
                       const wc_collider *col, wc_list_job *job)
 {
     const int32_t *idx = el->edges + 2 * (size_t)job->owner;
-    double reach = c->feature_r + element_margin(c, idx, 2), box[6], a[3], b[3];
-    element_box(c, idx, 2, reach, box);
-    int32_t n = query(m, &col->edge_bvh, box);
-    if (n < 0) return 0;
-    pair_entry *e = entries(m, n);
-    if (!e) return 0;
+    double margin = element_margin(c, idx, 2), a[3], b[3];
     base_of(c, idx[0], a), base_of(c, idx[1], b);
     int32_t kept = 0;
-    for (int32_t k = 0; k < n; ++k) {
-        int32_t f = m->found[k];
-        double p[3], q[3], u, v;
-        vertex_of(col->current, col->edges[2 * (size_t)f], p);
-        vertex_of(col->current, col->edges[2 * (size_t)f + 1], q);
-        /* cheap bound first: no point of the collider edge is nearer to the
-         * cloth edge than its midpoint's distance less half its length */
-        if (segment_lower_bound(p, q, a, b) > reach) continue;
-        double dist = sqrt(wci_segment_segment_closest(p, q, a, b, &u, &v));
-        if (dist <= reach) e[kept].d0 = dist, e[kept].item = f, ++kept;
+    pair_entry *e = NULL;
+    /* the sharp edges, then the smooth ones (collider.h) */
+    for (int smooth = 0; smooth < 2; ++smooth) {
+        double r = smooth && c->smooth_features ? c->feature_r : c->feature_r + c->sharp_shift;
+        double reach = r + margin, shift = smooth ? 0.0 : c->sharp_shift, box[6];
+        element_box(c, idx, 2, reach, box);
+        int32_t n = query(m, smooth ? &col->smooth_edge_bvh : &col->edge_bvh, box);
+        if (n < 0 || !(e = entries(m, kept + n, kept))) return 0;
+        const int32_t *order = col->edge_order + (smooth ? col->smooth_edges_from : 0);
+        for (int32_t k = 0; k < n; ++k) {
+            int32_t f = order[m->found[k]];
+            double p[3], q[3], u, v;
+            vertex_of(col->current, col->edges[2 * (size_t)f], p);
+            vertex_of(col->current, col->edges[2 * (size_t)f + 1], q);
+            /* cheap bound first: no point of the collider edge is nearer to
+             * the cloth edge than its midpoint's distance less half its
+             * length */
+            if (segment_lower_bound(p, q, a, b) > reach) continue;
+            double dist = sqrt(wci_segment_segment_closest(p, q, a, b, &u, &v));
+            if (dist <= reach) e[kept].d0 = dist - shift, e[kept].item = f, ++kept;
+        }
     }
     return keep_sorted(m, job, e, kept);
 }
@@ -599,6 +612,32 @@ static int allocate(wc_candidates *c, const wc_cloth_elements *el)
            c->frame && c->frame_step && c->own_step && c->own_reach && c->again;
 }
 
+/* Whether the smooth features keep the smaller distance (candidates.h):
+ * a cloth edge of length L across an edge where the surface turns by at
+ * most a (WC_SMOOTH_FEATURE_ANGLE), its ends on the faces' planes at r,
+ * passes the edge at r less at most (L / 2) tan(a / 2); within (1 -
+ * WC_FEATURE_DISTANCE) r of r, the faces hold the cloth where a sharp
+ * feature's test would, so that distance is all the smooth feature's test
+ * gives up. On a cloth whose edges are too long for that, every feature
+ * keeps the sharp distance. */
+static void choose_feature_distances(wc_candidates *c, const wc_cloth_elements *el, double r)
+{
+    double longest2 = 0.0;
+    for (int32_t e = 0; e < el->edge_count; ++e) {
+        const double *a = c->base + 3 * (size_t)el->edges[2 * (size_t)e];
+        const double *b = c->base + 3 * (size_t)el->edges[2 * (size_t)e + 1];
+        double d2 = (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+        if (d2 > longest2) longest2 = d2;
+    }
+    double dip = 0.5 * sqrt(longest2) * tan(0.5 * WC_SMOOTH_FEATURE_ANGLE);
+    c->smooth_features = !c->sharp_only && dip <= (1.0 - WC_FEATURE_DISTANCE) * r;
+    double sharp = WC_FEATURE_DISTANCE * r;
+    c->feature_r = c->smooth_features ? WC_SMOOTH_FEATURE_DISTANCE * r : sharp;
+    /* the exact test counts a touch nearer than its distance times
+     * sqrt(1 - WC_FEATURE_SLACK) */
+    c->sharp_shift = (sharp - c->feature_r) * sqrt(1.0 - WC_FEATURE_SLACK);
+}
+
 wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, const wc_collider *col,
                               double r, const wc_particle_arrays *p, int32_t steps_left, int threads)
 {
@@ -608,13 +647,13 @@ wc_status wci_candidates_update(wc_candidates *c, const wc_cloth_elements *el, c
         jobs > INT32_MAX || !ready_jobs(c, jobs, threads))
         return WC_ERROR_OUT_OF_MEMORY;
     c->r = r;
-    c->feature_r = WC_FEATURE_DISTANCE * r;
     for (int32_t i = 0; i < el->particle_count; ++i) {
         c->local_path[i] = 0.0, c->local_step[i] = 0.0;
         for (int k = 0; k < 3; ++k) c->frame[3 * (size_t)i + k] = 0.0, c->frame_step[3 * (size_t)i + k] = 0.0;
     }
     c->framed = 0;
     for (int32_t i = 0; i < el->particle_count; ++i) rebase_one(c, col, i, p, steps_left, 1);
+    choose_feature_distances(c, el, r);
     int32_t count = 0;
     for (int32_t i = 0; i < el->particle_count; ++i) add_job(c, &count, LIST_PARTICLE, i);
     for (int32_t t = 0; t < el->triangle_count; ++t) add_job(c, &count, LIST_TRIANGLE, t);
@@ -981,13 +1020,13 @@ double wci_pair_lists_end_drift(const wc_candidates *c, const wc_pair_lists *l, 
 
 void wci_pair_lists_renew(const wc_candidates *c, wc_pair_lists *l, int32_t k, const int32_t *particles,
                          const wc_particle_arrays *p, double collider_path, const int32_t *at,
-                         const double *measured2, int32_t n, double least_unmeasured,
-                         double drift_end, double ceiling)
+                         const double *measured2, const double *less, int32_t n,
+                         double least_unmeasured, double drift_end, double ceiling)
 {
     double *d = l->d + l->start[k], debt = l->debt[k] + drift_end, least = least_unmeasured;
     l->debt[k] = debt;
     for (int32_t j = 0; j < n; ++j) {
-        double measured = sqrt(measured2[j]);
+        double measured = less ? sqrt(measured2[j]) - less[j] : sqrt(measured2[j]);
         d[at[j]] = (measured < ceiling ? measured : ceiling) + debt;
         if (d[at[j]] < least) least = d[at[j]];
     }

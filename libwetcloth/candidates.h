@@ -10,7 +10,8 @@
  * is listed when d0 <= r + M (r the contact distance, M the largest margin
  * of the owner's particles; for the triangles' and edges' lists r is the
  * feature distance, WC_FEATURE_DISTANCE times the particles' in
- * narrowphase.h, and so it is in what follows). A particle's margin comes from its motion when
+ * narrowphase.h, or WC_SMOOTH_FEATURE_DISTANCE times it for a smooth
+ * feature where `smooth_features` says so, and so it is in what follows). A particle's margin comes from its motion when
  * it is rebased, so a resting cloth keeps its lists for as long as it rests
  * and a falling one rebases about once per margin travelled.
  *
@@ -96,6 +97,7 @@
 
 #include "broadphase.h"
 #include "collider.h"
+#include "narrowphase.h"
 #include "response.h"
 #include "wetcloth.h"
 
@@ -147,6 +149,19 @@ typedef struct wc_candidates {
     /// faces, and a cloth triangle's or edge's against collider features
     /// (WC_FEATURE_DISTANCE r); 0 until made.
     double r, feature_r;
+    /// Whether these lists keep the collider's smooth features (collider.h)
+    /// at the smooth feature distance (narrowphase.h): when the cloth's
+    /// longest edge, as the lists were first made, lying across a smooth
+    /// edge on faces it rests on at r, comes no nearer to it than the
+    /// feature distance of a sharp one (wci_candidates_update). Then
+    /// feature_r is the smooth distance, and a sharp feature's d is kept
+    /// `sharp_shift` less than its distance (the difference of the two
+    /// distances at which the exact test counts a touch), so that one
+    /// filter serves both; otherwise every feature is sharp and the shift 0.
+    int smooth_features;
+    double sharp_shift;
+    /// A test's switch: every feature sharp.
+    int sharp_only;
     /// Per particle: base position (xyz), margin, and its local path at its
     /// last rebase.
     double *base, *margin, *base_path;
@@ -194,6 +209,15 @@ typedef struct wc_cloth_elements {
 /// A zeroed wc_candidates is the empty set of lists (no memory); this frees its memory and
 /// leaves it zeroed, empty again.
 void wci_candidates_destroy(wc_candidates *cand);
+
+/// Feature f's contact distance in these lists, for contact distance r: f
+/// a collider vertex (a cloth triangle's list) or edge (an edge's).
+static inline double wc_candidates_feature_distance(const wc_candidates *cand, const wc_collider *col,
+                                                    int vertex, int32_t f, double r)
+{
+    int smooth = cand->smooth_features && (vertex ? col->vertex_smooth[f] : col->edge_smooth[f]);
+    return (smooth ? WC_SMOOTH_FEATURE_DISTANCE : WC_FEATURE_DISTANCE) * r;
+}
 
 /// Particle i's local path by the end of the step being computed.
 static inline double wc_candidates_path_now(const wc_candidates *cand, int32_t i)
@@ -293,14 +317,16 @@ double wci_pair_lists_end_drift(const wc_candidates *cand, const wc_pair_lists *
 /// After a visit of owner k that moved nothing: its snapshot renewed at its
 /// particles' present ends and the collider's end of step. The items at
 /// positions at[0 .. n) were measured, at squared distances measured2[0 ..
-/// n), each credited with at most `ceiling` (wci_candidates_ceiling); the
+/// n), each kept less[j] less than its distance (NULL: 0; a sharp
+/// feature's shift) and credited with at most `ceiling`
+/// (wci_candidates_ceiling); the
 /// others keep their bound less `drift_end` (how far owner and collider can
 /// have moved from the old snapshot to now), and the least of their d is
 /// `least_unmeasured` (INFINITY if none). `collider_path` is the local path
 /// that the owner's drift is measured against, now.
 void wci_pair_lists_renew(const wc_candidates *cand, wc_pair_lists *l, int32_t k, const int32_t *particles,
                          const wc_particle_arrays *p, double collider_path, const int32_t *at,
-                         const double *measured2, int32_t n, double least_unmeasured,
+                         const double *measured2, const double *less, int32_t n, double least_unmeasured,
                          double drift_end, double ceiling);
 
 /// Distance from a point to a collider triangle, vertex and edge in the

@@ -48,12 +48,16 @@ void wci_collider_destroy(wc_collider *c)
     wci_free(c->edge_boxes);
     wci_free(c->vertex_boxes);
     wci_free(c->used_vertices);
+    wci_free(c->vertex_smooth), wci_free(c->edge_smooth);
+    wci_free(c->class_edges), wci_free(c->edge_order);
     wci_free(c->normals);
     wci_free(c->triangle_shift);
     wci_free(c->node_shift);
     wci_bvh_destroy(&c->bvh);
     wci_bvh_destroy(&c->edge_bvh);
     wci_bvh_destroy(&c->vertex_bvh);
+    wci_bvh_destroy(&c->smooth_edge_bvh);
+    wci_bvh_destroy(&c->smooth_vertex_bvh);
     wci_convex_shape_destroy(&c->convex);
     wci_free(c);
 }
@@ -109,6 +113,101 @@ static int build_edges(wc_collider *c)
     c->edge_count = unique;
     wci_free(entries);
     return 1;
+}
+
+/* Edge (a, b), a < b, in the sorted unique edges: its index, -1 if none. */
+static int32_t find_edge(const wc_collider *c, int32_t a, int32_t b)
+{
+    int32_t lo = 0, hi = c->edge_count - 1;
+    while (lo <= hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        const int32_t *e = c->edges + 2 * (size_t)mid;
+        if (e[0] == a && e[1] == b) return mid;
+        if (e[0] < a || (e[0] == a && e[1] < b)) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return -1;
+}
+
+/* Which vertices and edges are smooth (collider.h), from the positions in
+ * `current`. An edge is smooth when exactly two faces meet there and their
+ * normals differ by at most WC_SMOOTH_FEATURE_ANGLE; a vertex when its faces'
+ * normals all lie within half of it of their mean and no sharp edge ends at
+ * it. A rim (an edge of one face), a seam of three faces and anything
+ * touching a degenerate triangle are sharp. `normals` (one per triangle)
+ * and `mean` (xyz per vertex) are scratch. */
+static void classify_features(wc_collider *c, double *normals, double *mean)
+{
+    double cos_edge = cos(WC_SMOOTH_FEATURE_ANGLE), cos_vertex = cos(0.5 * WC_SMOOTH_FEATURE_ANGLE);
+    int32_t *first_face = c->class_edges; /* scratch until the order is made */
+    for (int32_t e = 0; e < c->edge_count; ++e) c->edge_smooth[e] = 0, first_face[e] = -1;
+    memset(mean, 0, 3 * (size_t)c->vertex_count * sizeof *mean);
+    for (int32_t v = 0; v < c->vertex_count; ++v) c->vertex_smooth[v] = 1;
+    for (int32_t t = 0; t < c->triangle_count; ++t) {
+        const int32_t *v = c->triangles + 3 * (size_t)t;
+        double *n = normals + 3 * (size_t)t;
+        wci_triangle_normal(c->current + 3 * (size_t)v[0], c->current + 3 * (size_t)v[1],
+                            c->current + 3 * (size_t)v[2], n);
+        int degenerate = n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
+        for (int k = 0; k < 3; ++k) {
+            for (int m = 0; m < 3; ++m) mean[3 * (size_t)v[k] + m] += n[m];
+            if (degenerate) c->vertex_smooth[v[k]] = 0;
+            int32_t a = v[k], b = v[(k + 1) % 3];
+            int32_t e = find_edge(c, a < b ? a : b, a < b ? b : a);
+            if (e < 0) continue; /* a collapsed edge */
+            /* edge_smooth counts the faces met so far (2 at most, 3 = a seam) */
+            if (first_face[e] < 0) {
+                first_face[e] = degenerate ? -2 : t;
+                c->edge_smooth[e] = 1;
+                continue;
+            }
+            const double *f = first_face[e] >= 0 ? normals + 3 * (size_t)first_face[e] : NULL;
+            int turns = degenerate || !f || n[0] * f[0] + n[1] * f[1] + n[2] * f[2] < cos_edge;
+            c->edge_smooth[e] = (uint8_t)(c->edge_smooth[e] == 1 && !turns ? 2 : 3);
+        }
+    }
+    for (int32_t v = 0; v < c->vertex_count; ++v) {
+        double *m = mean + 3 * (size_t)v, len = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+        if (len > 0.0) m[0] /= len, m[1] /= len, m[2] /= len;
+        else c->vertex_smooth[v] = 0;
+    }
+    for (int32_t t = 0; t < c->triangle_count; ++t) {
+        const int32_t *v = c->triangles + 3 * (size_t)t;
+        const double *n = normals + 3 * (size_t)t;
+        for (int k = 0; k < 3; ++k) {
+            const double *m = mean + 3 * (size_t)v[k];
+            if (n[0] * m[0] + n[1] * m[1] + n[2] * m[2] < cos_vertex) c->vertex_smooth[v[k]] = 0;
+        }
+    }
+    for (int32_t e = 0; e < c->edge_count; ++e) {
+        c->edge_smooth[e] = c->edge_smooth[e] == 2;
+        if (!c->edge_smooth[e])
+            c->vertex_smooth[c->edges[2 * (size_t)e]] = c->vertex_smooth[c->edges[2 * (size_t)e + 1]] = 0;
+    }
+}
+
+/* The used vertices and the edges in class order (collider.h): sharp, then
+ * smooth, each ascending. */
+static void order_by_class(wc_collider *c)
+{
+    int32_t *used = c->used_vertices, n = 0;
+    int32_t *scratch = c->edge_order; /* free until the edges are ordered */
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1) c->smooth_vertices_from = n;
+        for (int32_t k = 0; k < c->used_vertex_count; ++k)
+            if (c->vertex_smooth[used[k]] == pass) scratch[n++] = used[k];
+    }
+    memcpy(used, scratch, (size_t)n * sizeof *used);
+    n = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1) c->smooth_edges_from = n;
+        for (int32_t e = 0; e < c->edge_count; ++e)
+            if (c->edge_smooth[e] == pass) c->edge_order[n++] = e;
+    }
+    for (int32_t k = 0; k < c->edge_count; ++k) {
+        c->class_edges[2 * (size_t)k] = c->edges[2 * (size_t)c->edge_order[k]];
+        c->class_edges[2 * (size_t)k + 1] = c->edges[2 * (size_t)c->edge_order[k] + 1];
+    }
 }
 
 static wc_status append_collider(wc_world *w, wc_collider *c, int32_t *out)
@@ -187,6 +286,8 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
         memset(&c->bvh, 0, sizeof c->bvh);
         memset(&c->edge_bvh, 0, sizeof c->edge_bvh);
         memset(&c->vertex_bvh, 0, sizeof c->vertex_bvh);
+        memset(&c->smooth_edge_bvh, 0, sizeof c->smooth_edge_bvh);
+        memset(&c->smooth_vertex_bvh, 0, sizeof c->smooth_vertex_bvh);
         c->triangles = wci_alloc_array(3 * nt, sizeof *c->triangles);
         c->current = wci_alloc_array(nv, sizeof *c->current);
         c->target = wci_alloc_array(nv, sizeof *c->target);
@@ -212,6 +313,22 @@ wc_status wc_world_add_mesh_collider(wc_world *w, const wc_mesh_collider_def *d,
     memcpy(c->current, d->vertices, nv * sizeof *c->current);
     memcpy(c->target, d->vertices, nv * sizeof *c->target);
     memcpy(c->next, d->vertices, nv * sizeof *c->next);
+    size_t ne = (size_t)(c->edge_count ? c->edge_count : 1);
+    c->vertex_smooth = wci_alloc_array(nv / 3 ? nv / 3 : 1, 1);
+    c->edge_smooth = wci_alloc_array(ne, 1);
+    /* edge_order must hold the used vertices too (order_by_class's scratch) */
+    c->edge_order = wci_alloc_array(ne > nv / 3 ? ne : nv / 3 ? nv / 3 : 1, sizeof *c->edge_order);
+    c->class_edges = wci_alloc_array(2 * ne, sizeof *c->class_edges);
+    double *mean = wci_alloc_array(nv ? nv : 1, sizeof *mean);
+    if (!c->vertex_smooth || !c->edge_smooth || !c->edge_order || !c->class_edges || !mean) {
+        wci_free(mean);
+        wci_collider_destroy(c);
+        return wci_fail(&w->error, WC_ERROR_OUT_OF_MEMORY, "out of memory adding a mesh collider");
+    }
+    /* the normals are made again at the first step */
+    classify_features(c, c->normals, mean);
+    wci_free(mean);
+    order_by_class(c);
     return append_collider(w, c, out);
 }
 
@@ -226,6 +343,8 @@ wc_status wc_world_add_convex_collider(wc_world *w, const wc_convex_collider_def
     memset(&c->bvh, 0, sizeof c->bvh);
     memset(&c->edge_bvh, 0, sizeof c->edge_bvh);
     memset(&c->vertex_bvh, 0, sizeof c->vertex_bvh);
+    memset(&c->smooth_edge_bvh, 0, sizeof c->smooth_edge_bvh);
+    memset(&c->smooth_vertex_bvh, 0, sizeof c->smooth_vertex_bvh);
     wc_status s = wci_convex_shape_create(&c->convex, &c->pose_current, d, &w->error);
     if (s) {
         wci_collider_destroy(c);
@@ -347,7 +466,7 @@ static wc_status index_boxes(wc_bvh *bvh, const double *boxes, int32_t count)
 static wc_status index_mesh(wc_collider *c)
 {
     advance_boxes(c, c->triangles, 3, c->triangle_count, c->boxes);
-    advance_boxes(c, c->edges, 2, c->edge_count, c->edge_boxes);
+    advance_boxes(c, c->class_edges, 2, c->edge_count, c->edge_boxes);
     advance_boxes(c, c->used_vertices, 1, c->used_vertex_count, c->vertex_boxes);
     int first = c->bvh.node_count == 0;
     if (index_boxes(&c->bvh, c->boxes, c->triangle_count)) return WC_ERROR_OUT_OF_MEMORY;
@@ -362,8 +481,11 @@ static wc_status index_mesh(wc_collider *c)
         c->feature_size = c->edge_count ? total / c->edge_count : 0.0;
     }
     /* (a tree that could not be made is made at the next call) */
-    if (index_boxes(&c->edge_bvh, c->edge_boxes, c->edge_count) ||
-        index_boxes(&c->vertex_bvh, c->vertex_boxes, c->used_vertex_count))
+    int32_t ns = c->smooth_edges_from, vs = c->smooth_vertices_from;
+    if (index_boxes(&c->edge_bvh, c->edge_boxes, ns) ||
+        index_boxes(&c->smooth_edge_bvh, c->edge_boxes + 6 * (size_t)ns, c->edge_count - ns) ||
+        index_boxes(&c->vertex_bvh, c->vertex_boxes, vs) ||
+        index_boxes(&c->smooth_vertex_bvh, c->vertex_boxes + 6 * (size_t)vs, c->used_vertex_count - vs))
         return WC_ERROR_OUT_OF_MEMORY;
     memcpy(c->bounds, c->bvh.nodes[0].box, sizeof c->bounds);
     c->indexed = 1;

@@ -10,6 +10,13 @@
 #include "broadphase.h"
 #include "wetcloth.h"
 
+/// The most a collider's surface may turn at a smooth feature, radians
+/// (6 degrees): an edge whose two faces' normals differ by no more, a vertex
+/// whose faces' normals all lie within half of it of their mean. A UV
+/// sphere of 64 segments turns by 5.6 degrees at an edge, the thesis' 16
+/// segments by 22.5.
+#define WC_SMOOTH_FEATURE_ANGLE (6.0 * 3.14159265358979323846 / 180.0)
+
 /// Position and orientation: x_world = position + rotate(rotation, x_local).
 typedef struct wc_pose {
     double position[3];
@@ -70,6 +77,23 @@ typedef struct wc_collider {
     wc_bvh edge_bvh, vertex_bvh;
     int32_t *used_vertices;
     int32_t used_vertex_count;
+    /// Per vertex and per edge: whether the feature is smooth (the surface
+    /// turns there by no more than WC_SMOOTH_FEATURE_ANGLE; classify_features
+    /// in collider.c), judged on the shape the collider was made with. A
+    /// smooth feature of a dense mesh lies within a fraction of a millimetre
+    /// of the faces around it, which hold the cloth off it already; its own
+    /// test is kept at a smaller distance (narrowphase.h), so that the lists
+    /// of a cloth resting on the faces need not hold it (candidates.c).
+    uint8_t *vertex_smooth, *edge_smooth;
+    /// The used vertices are in two runs, the sharp ones then the smooth
+    /// ones (each ascending), split at smooth_vertices_from; the edges'
+    /// vertex pairs and indices likewise in `class_edges` and `edge_order`.
+    /// edge_boxes and vertex_boxes follow these orders; edge_bvh and
+    /// vertex_bvh index the sharp runs, the smooth trees the smooth runs
+    /// (their items counted from the run's start).
+    int32_t *class_edges, *edge_order;
+    int32_t smooth_edges_from, smooth_vertices_from;
+    wc_bvh smooth_edge_bvh, smooth_vertex_bvh;
     /// Whether the boxes and the tree describe the running advance.
     int indexed;
     /// Mean length of the triangles' edges when the tree was built: the

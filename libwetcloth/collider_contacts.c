@@ -39,7 +39,7 @@ struct wc_collider_contacts {
     /// Per collider (by index): the candidates; made at first use.
     wc_candidates *cand;
     int32_t cand_count;
-    int use_filter, whole_collider;
+    int use_filter, whole_collider, sharp_only;
     /// Between rounds: recheck (the particle pass must test the particle
     /// again) and shifted (the feature pass must visit its elements).
     uint8_t *recheck, *shifted;
@@ -66,6 +66,9 @@ struct wc_collider_contacts {
     /// and the distance measured for each (snapshots); room for kept_capacity.
     int32_t *kept;
     double *measured;
+    /// What each measured distance is kept less in its list (a sharp
+    /// feature's shift, candidates.h).
+    double *measured_less;
     int32_t kept_capacity;
     /// Per particle: its motion over the step (start to end, as it is).
     double *motion;
@@ -201,7 +204,7 @@ void wci_collider_contacts_destroy(wc_collider_contacts *s)
                       s->el.edges_start, s->el.edges_of, s->recheck, s->changed, s->shifted, s->carry,
                       s->moved, s->moving, s->moved_list, s->moving_list, s->rebase_list,
                       s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->measured,
-                      s->motion};
+                      s->measured_less, s->motion};
     for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) wci_free(blocks[k]);
     wci_free(s);
 }
@@ -214,6 +217,18 @@ void wci_collider_contacts_commit(wc_collider_contacts *s, int32_t particle_coun
 void wci_collider_contacts_use_filter(wc_collider_contacts *s, int use) { s->use_filter = use; }
 
 void wci_collider_contacts_use_local_motion(wc_collider_contacts *s, int use) { s->whole_collider = !use; }
+
+void wci_collider_contacts_use_smooth_features(wc_collider_contacts *s, int use)
+{
+    s->sharp_only = !use;
+    /* the lists are made again, at the next step, with the distances chosen */
+    for (int32_t k = 0; k < s->cand_count; ++k) s->cand[k].r = 0.0;
+}
+
+int wci_collider_contacts_smooth_features(const wc_collider_contacts *s, int32_t collider)
+{
+    return collider >= 0 && collider < s->cand_count && s->cand[collider].smooth_features;
+}
 
 void wci_collider_contacts_use_apart(wc_collider_contacts *s, int use) { s->use_apart = use; }
 
@@ -292,6 +307,7 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         if (!col->is_mesh) continue;
         wc_candidates *cand = &s->cand[k];
         cand->whole_collider = s->whole_collider;
+        cand->sharp_only = s->sharp_only;
         double r = contact_distance(c, col);
         if (cand->r != r) {
             if (wci_candidates_update(cand, &s->el, col, r, p, steps_left, threads))
@@ -502,7 +518,7 @@ static void renew_particle(const wc_candidates *cand, const wc_particle_arrays *
     double end_drift = wci_pair_lists_end_drift(cand, l, i, &i, p) + (now - l->path_at[i]);
     /* the collider counted from before this step, which may yet be refused
      * and taken again (as in visit_element) */
-    wci_pair_lists_renew(cand, l, i, &i, p, now - 2.0 * step, m->at, m->d2, m->n, m->rest, end_drift,
+    wci_pair_lists_renew(cand, l, i, &i, p, now - 2.0 * step, m->at, m->d2, NULL, m->n, m->rest, end_drift,
                         wci_candidates_ceiling(cand, cand->r, &i, 1, p));
 }
 
@@ -718,12 +734,13 @@ static int feature_scratch(wc_collider_contacts *s, int32_t n)
     int32_t cap = 2 * n + 16;
     int32_t *kept = wci_alloc_array((size_t)cap, sizeof *kept);
     double *measured = wci_alloc_array((size_t)cap, sizeof *measured);
-    if (!kept || !measured) {
-        wci_free(kept), wci_free(measured);
+    double *less = wci_alloc_array((size_t)cap, sizeof *less);
+    if (!kept || !measured || !less) {
+        wci_free(kept), wci_free(measured), wci_free(less);
         return 0;
     }
-    wci_free(s->kept), wci_free(s->measured);
-    s->kept = kept, s->measured = measured;
+    wci_free(s->kept), wci_free(s->measured), wci_free(s->measured_less);
+    s->kept = kept, s->measured = measured, s->measured_less = less;
     s->kept_capacity = cap;
     return 1;
 }
@@ -750,7 +767,9 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
     const int32_t *idx = kind->particles + (size_t)kind->count * (size_t)e;
     const wc_pair_lists *l = kind->lists;
     const wc_candidates *cand = &s->cand[k];
-    double reach = feature_reach(r) + FILTER_EPSILON(r);
+    /* the lists' distances are a smooth feature's (a sharp one's d is kept
+     * sharp_shift less: candidates.h), so one reach filters both */
+    double reach = feature_reach(cand->feature_r) + FILTER_EPSILON(cand->feature_r);
     /* nothing in the list can touch: the cheap way out of most visits,
      * least - debt - path - drift > reach compared on squares (the filter's
      * epsilon is far above the rounding by which the two forms differ) */
@@ -773,13 +792,15 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
         for (int32_t j = 0; j < n && hit < 0; ++j) {
             int32_t f = l->item[l->start[e] + s->kept[j]];
             double fm = feature_motion(col, kind, f);
-            int ccd = wci_narrow_needs_ccd(motion > fm ? motion : fm, r);
+            double rf = wc_candidates_feature_distance(cand, col, kind->count == 3, f, r);
+            int ccd = wci_narrow_needs_ccd(motion > fm ? motion : fm, rf);
             double d2;
             wc_contact ct;
-            int touch = kind->count == 3 ? wci_narrow_vertex_triangle(p, idx, col, f, ccd, r, &d2, &ct)
-                                         : wci_narrow_edge_edge(p, idx, col, f, ccd, r, &d2, &ct);
+            int touch = kind->count == 3 ? wci_narrow_vertex_triangle(p, idx, col, f, ccd, rf, &d2, &ct)
+                                         : wci_narrow_edge_edge(p, idx, col, f, ccd, rf, &d2, &ct);
             /* squared: the renewal takes the root, off this loop's path */
             s->measured[j] = d2;
+            s->measured_less[j] = rf > cand->feature_r ? cand->sharp_shift : 0.0;
             ++s->feature_tests;
             if (!touch) continue;
             ct.friction = mu, ct.wet_friction = c->material.wet_friction;
@@ -805,8 +826,9 @@ static int visit_element(wc_collider_contacts *s, wc_cloth *c, const wc_particle
          * counted from the committed path less this step's motion, the
          * drift covers the collider from there as well as from where it
          * really goes. */
-        wci_pair_lists_renew(cand, (wc_pair_lists *)l, e, idx, p, now - 2.0 * step, s->kept, s->measured, n, rest,
-                            end_drift, wci_candidates_ceiling(cand, cand->feature_r, idx, kind->count, p));
+        wci_pair_lists_renew(cand, (wc_pair_lists *)l, e, idx, p, now - 2.0 * step, s->kept, s->measured,
+                            cand->sharp_shift > 0.0 ? s->measured_less : NULL, n, rest, end_drift,
+                            wci_candidates_ceiling(cand, cand->feature_r, idx, kind->count, p));
     }
     return pushed;
 }
@@ -878,7 +900,7 @@ static int feature_pass(wc_collider_contacts *s, wc_cloth *c, const wc_particle_
         for (int32_t k = 0; k < count; ++k) {
             const wc_collider *col = colliders[k];
             if (!col->is_mesh) continue;
-            double r = WC_FEATURE_DISTANCE * contact_distance(c, col);
+            double r = contact_distance(c, col);
             const wc_candidates *cand = &s->cand[k];
             element_kind triangles = {3, s->el.triangles, &cand->triangles, s->el.triangles_start,
                                       s->el.triangles_of};

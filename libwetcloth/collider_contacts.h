@@ -73,6 +73,16 @@ void wci_collider_contacts_use_local_motion(wc_collider_contacts *state, int use
 /// bit; tests compare the two.
 void wci_collider_contacts_use_filter(wc_collider_contacts *state, int use);
 
+/// Tests: whether the candidates may keep the colliders' smooth features at
+/// the smooth distance (candidates.h; 1 by default). Changing it makes the
+/// lists again at the next step.
+void wci_collider_contacts_use_smooth_features(wc_collider_contacts *state, int use);
+
+/// Tests: whether the lists against the collider at `collider` (its index
+/// among the world's colliders) keep its smooth features at the smooth
+/// distance.
+int wci_collider_contacts_smooth_features(const wc_collider_contacts *state, int32_t collider);
+
 /// Test switch: 1 (default) skips the whole stage for a step in which the
 /// box of the cloth's particles (start and end) is farther than twice the
 /// contact distance from every collider's bounds (a falling cloth, one far
