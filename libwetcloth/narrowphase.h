@@ -55,7 +55,7 @@
 /// lists' reach (0.9 r plus a margin of up to 0.5 r), and making those
 /// lists was half of a frame on a dense collider (the bending tube: 1.04 M
 /// vertex and 11.2 M edge pairs listed over 24 frames, 221 ms of
-/// collisions per frame; at half r 0.66 M and 1.25 M, 111 ms). At half r,
+/// collisions per frame; at half r 0.66 M and 1.25 M, 115 ms). At half r,
 /// no more than r with the largest margin, it is listed only when the
 /// cloth comes nearer to it than to the faces. Any positive distance keeps
 /// the guarantee: the cloth does not cross it.
