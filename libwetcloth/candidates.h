@@ -147,11 +147,12 @@ typedef struct wc_pair_lists {
 typedef struct wc_candidates {
     /// Contact distances the lists were made for: a particle's against
     /// faces, and a cloth triangle's or edge's against collider features
-    /// (WC_FEATURE_DISTANCE r); 0 until made.
+    /// (WC_FEATURE_DISTANCE r, or the smooth distance: smooth_features);
+    /// 0 until made.
     double r, feature_r;
     /// Whether these lists keep the collider's smooth features (collider.h)
     /// at the smooth feature distance (narrowphase.h): when the cloth's
-    /// longest edge, as the lists were first made, lying across a smooth
+    /// longest edge, where the lists were all made, lying across a smooth
     /// edge on faces it rests on at r, comes no nearer to it than the
     /// feature distance of a sharp one (wci_candidates_update). Then
     /// feature_r is the smooth distance, and a sharp feature's d is kept
