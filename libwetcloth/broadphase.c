@@ -31,30 +31,32 @@ static void union_box(double box[6], const double add[6])
     }
 }
 
-/* Twice the centre of item i along an axis; NaN sorts last. */
+/* Twice the centre of item i along an axis; NaN sorts last. The build
+ * reads them from `keys` (xyz per item, made once): a node's split then
+ * reads one number per item, where the boxes cost two and a box union. */
 static double key(const double *boxes, int32_t i, int axis)
 {
     double k = boxes[6 * (size_t)i + axis] + boxes[6 * (size_t)i + axis + 3];
     return k == k ? k : INFINITY;
 }
 
-static int before(const double *boxes, int32_t a, int32_t b, int axis)
+static int before(const double *keys, int32_t a, int32_t b, int axis)
 {
-    double ka = key(boxes, a, axis), kb = key(boxes, b, axis);
+    double ka = keys[3 * (size_t)a + axis], kb = keys[3 * (size_t)b + axis];
     return ka < kb || (ka == kb && a < b);
 }
 
 /* Reorders items[0 .. n) so that items[m] is the one a full sort would put
  * there, smaller ones before it and larger after (quickselect, middle
  * pivot; deterministic). */
-static void select_median(const double *boxes, int32_t *items, int32_t n, int32_t m, int axis)
+static void select_median(const double *keys, int32_t *items, int32_t n, int32_t m, int axis)
 {
     int32_t lo = 0, hi = n - 1;
     while (lo < hi) {
         int32_t pivot = items[lo + (hi - lo) / 2], i = lo, j = hi;
         while (i <= j) {
-            while (before(boxes, items[i], pivot, axis)) ++i;
-            while (before(boxes, pivot, items[j], axis)) --j;
+            while (before(keys, items[i], pivot, axis)) ++i;
+            while (before(keys, pivot, items[j], axis)) --j;
             if (i <= j) {
                 int32_t t = items[i];
                 items[i] = items[j], items[j] = t;
@@ -67,15 +69,13 @@ static void select_median(const double *boxes, int32_t *items, int32_t n, int32_
     }
 }
 
-/* Box of items[0 .. n) and the axis along which their centres spread most. */
-static int split_axis(const double *boxes, const int32_t *items, int32_t n, double box[6])
+/* The axis along which the centres of items[0 .. n) spread most. */
+static int split_axis(const double *keys, const int32_t *items, int32_t n)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    empty_box(box);
     for (int32_t k = 0; k < n; ++k) {
-        union_box(box, boxes + 6 * (size_t)items[k]);
         for (int a = 0; a < 3; ++a) {
-            double c = key(boxes, items[k], a);
+            double c = keys[3 * (size_t)items[k] + a];
             if (c == INFINITY) continue;
             if (c < lo[a]) lo[a] = c;
             if (c > hi[a]) hi[a] = c;
@@ -94,12 +94,17 @@ wc_status wci_bvh_create(wc_bvh *b, const double *boxes, int32_t count)
     if (count <= 0) return WC_OK;
     b->order = wci_alloc_array((size_t)count, sizeof *b->order);
     b->nodes = wci_alloc_array(2 * (size_t)count, sizeof *b->nodes);
-    if (!b->order || !b->nodes) {
+    double *keys = wci_alloc_array(3 * (size_t)count, sizeof *keys);
+    if (!b->order || !b->nodes || !keys) {
+        wci_free(keys);
         wci_bvh_destroy(b);
         return WC_ERROR_OUT_OF_MEMORY;
     }
     b->item_count = count;
-    for (int32_t i = 0; i < count; ++i) b->order[i] = i;
+    for (int32_t i = 0; i < count; ++i) {
+        b->order[i] = i;
+        for (int a = 0; a < 3; ++a) keys[3 * (size_t)i + a] = key(boxes, i, a);
+    }
     /* Top-down: a node holds a run of `order`; one with more than a leaf's
      * worth is split at the median of its centres along its widest axis,
      * its children taking the two halves (allocated as a pair, after it:
@@ -111,10 +116,10 @@ wc_status wci_bvh_create(wc_bvh *b, const double *boxes, int32_t count)
     while (depth > 0) {
         wc_bvh_node *node = b->nodes + stack[--depth];
         int32_t first = node->first, n = node->count;
-        int axis = split_axis(boxes, b->order + first, n, node->box);
         if (n <= WC_BVH_LEAF || depth + 2 > STACK_DEPTH) continue;
+        int axis = split_axis(keys, b->order + first, n);
         int32_t half = n / 2;
-        select_median(boxes, b->order + first, n, half, axis);
+        select_median(keys, b->order + first, n, half, axis);
         int32_t left = b->node_count;
         b->node_count += 2;
         b->nodes[left].first = first, b->nodes[left].count = half;
@@ -123,6 +128,9 @@ wc_status wci_bvh_create(wc_bvh *b, const double *boxes, int32_t count)
         stack[depth++] = left + 1;
         stack[depth++] = left;
     }
+    wci_free(keys);
+    /* every node's box, leaves first */
+    wci_bvh_refit(b);
     return WC_OK;
 }
 
