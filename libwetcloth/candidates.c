@@ -375,6 +375,16 @@ static int particle_pairs(const wc_candidates *c, wc_list_maker *m, const wc_col
     return keep_sorted(m, job, e, kept);
 }
 
+/* A feature list's reach for one class of features (smooth or sharp:
+ * candidates.h), its owner's margin given, and how much less than its
+ * distance a pair of that class is listed (*shift). */
+static double class_reach(const wc_candidates *c, int smooth, double margin, double *shift)
+{
+    *shift = smooth ? 0.0 : c->sharp_shift;
+    double r = smooth && c->smooth_features ? c->feature_r : c->feature_r + c->sharp_shift;
+    return r + margin;
+}
+
 /* Cloth triangle t's pairs: collider vertices within the feature distance
  * plus M of it (its corners at their bases), from the collider's vertex
  * tree. */
@@ -388,8 +398,7 @@ static int triangle_pairs(const wc_candidates *c, wc_list_maker *m, const wc_clo
     pair_entry *e = NULL;
     /* the sharp vertices, then the smooth ones (collider.h) */
     for (int smooth = 0; smooth < 2; ++smooth) {
-        double r = smooth && c->smooth_features ? c->feature_r : c->feature_r + c->sharp_shift;
-        double reach = r + margin, shift = smooth ? 0.0 : c->sharp_shift, box[6];
+        double shift, reach = class_reach(c, smooth, margin, &shift), box[6];
         element_box(c, idx, 3, reach, box);
         int32_t n = query(m, smooth ? &col->smooth_vertex_bvh : &col->vertex_bvh, box);
         if (n < 0 || !(e = entries(m, kept + n, kept))) return 0;
@@ -439,8 +448,7 @@ static int edge_pairs(const wc_candidates *c, wc_list_maker *m, const wc_cloth_e
     pair_entry *e = NULL;
     /* the sharp edges, then the smooth ones (collider.h) */
     for (int smooth = 0; smooth < 2; ++smooth) {
-        double r = smooth && c->smooth_features ? c->feature_r : c->feature_r + c->sharp_shift;
-        double reach = r + margin, shift = smooth ? 0.0 : c->sharp_shift, box[6];
+        double shift, reach = class_reach(c, smooth, margin, &shift), box[6];
         element_box(c, idx, 2, reach, box);
         int32_t n = query(m, smooth ? &col->smooth_edge_bvh : &col->edge_bvh, box);
         if (n < 0 || !(e = entries(m, kept + n, kept))) return 0;

@@ -450,6 +450,24 @@ static uint64_t sphere_drop_hash(int32_t threads)
     return h;
 }
 
+/* Adds a UV sphere of `segments` x `rings` about the origin as a mesh
+ * collider of the given thickness (friction 0.5, the default); returns its
+ * index. */
+static int32_t add_sphere(wc_world *w, double radius, int32_t segments, int32_t rings, double thickness)
+{
+    size_t nv = 2 + (size_t)(rings - 1) * (size_t)segments, nt = 2 * (size_t)segments * (size_t)(rings - 1);
+    double *v = malloc(3 * nv * sizeof *v);
+    int32_t *t = malloc(3 * nt * sizeof *t), count, col = -1;
+    CHECK(v && t, "out of memory");
+    if (!v || !t) exit(test_report("test_collide"));
+    wc_mesh_collider_def d = wc_mesh_collider_def_default();
+    d.vertex_count = scene_uv_sphere(radius, segments, rings, v, t, &count);
+    d.vertices = v, d.triangles = t, d.triangle_count = count, d.thickness = thickness;
+    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    free(v), free(t);
+    return col;
+}
+
 /* The same with the default integrator (the implicit one) and a denser
  * sphere of Blender's collider thickness, 0.02 m: the candidates' lists,
  * made on the world's threads in several batches (about 24,000 of them at
@@ -462,13 +480,7 @@ static uint64_t thick_drop_hash(int32_t threads, int32_t side)
     def.thread_count = threads;
     def.adapt_threads = 0; /* exactly `threads`, from the first step: the lists made in parallel */
     wc_world *w = scene_world_from(&def);
-    static double v[3 * (2 + 31 * 64)];
-    static int32_t t[3 * 2 * 64 * 31];
-    int32_t nt, col;
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertex_count = scene_uv_sphere(0.3, 64, 32, v, t, &nt);
-    d.vertices = v, d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
-    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    add_sphere(w, 0.3, 64, 32, 0.02);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = side;
     g.center[2] = 0.33; /* within the contact distance of the top at once */
@@ -503,13 +515,7 @@ static wc_world *thick_sphere_world(int32_t side, double size, double z, double 
     wc_world_def def = wc_world_def_default();
     def.thread_count = 1;
     wc_world *w = scene_world_from(&def);
-    static double v[3 * (2 + 31 * 64)];
-    static int32_t t[3 * 2 * 64 * 31];
-    int32_t nt, col;
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertex_count = scene_uv_sphere(0.5, 64, 32, v, t, &nt);
-    d.vertices = v, d.triangles = t, d.triangle_count = nt, d.thickness = 0.02, d.friction = 0.5;
-    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    add_sphere(w, 0.5, 64, 32, 0.02);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = side;
     g.size_u = g.size_v = size;
@@ -664,16 +670,10 @@ static void filter_is_exact(wc_integrator integrator, int steps_per_frame, const
  * distance and the bits changed: checked.) */
 static uint64_t thick_thesis_hash(int use_filter, int *smooth_chosen)
 {
-    static double v[3 * 114];
-    static int32_t t[3 * 224];
     wc_world_def def = wc_world_def_default();
     def.thread_count = 1;
     wc_world *w = scene_world_from(&def);
-    int32_t nt, col, cl;
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertex_count = scene_uv_sphere(0.3, 16, 8, v, t, &nt);
-    d.vertices = v, d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
-    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    int32_t cl, col = add_sphere(w, 0.3, 16, 8, 0.02);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = 20;
     g.center[2] = 0.6;
@@ -1224,17 +1224,10 @@ static void smooth_features_classified(void)
  * edges of 0.2 m, diagonals of 0.28 m) keeps the sharp one. */
 static uint64_t drop_on_dense_sphere(int32_t side, int smooth, int frames, int64_t *listed, int *chosen)
 {
-    enum { SEG = 176, RINGS = 88 };
-    static double v[3 * (2 + (RINGS - 1) * SEG)];
-    static int32_t t[3 * 2 * SEG * (RINGS - 1)];
     wc_world_def def = wc_world_def_default();
     def.thread_count = 1;
     wc_world *w = scene_world_from(&def);
-    int32_t nt, col, cl;
-    wc_mesh_collider_def d = wc_mesh_collider_def_default();
-    d.vertex_count = scene_uv_sphere(0.3, SEG, RINGS, v, t, &nt);
-    d.vertices = v, d.triangles = t, d.triangle_count = nt, d.thickness = 0.02;
-    CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
+    int32_t cl, col = add_sphere(w, 0.3, 176, 88, 0.02);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = side;
     g.center[2] = 0.4;
