@@ -579,7 +579,7 @@ void wci_collider_end_step(wc_collider *c)
         c->step_motion = 0.0;
         c->moving = memcmp(c->current, c->target, bytes) != 0;
         /* at rest now: tight boxes again, and normals for good */
-        if (!c->moving) c->indexed = 0, c->normals_current = 0;
+        if (!c->moving) c->indexed = 0, c->normals_current = 0, ++c->shape;
     } else {
         c->pose_current = c->pose_next;
         c->moving = memcmp(&c->pose_current, &c->pose_target, sizeof c->pose_current) != 0;

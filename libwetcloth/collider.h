@@ -105,6 +105,10 @@ typedef struct wc_collider {
     /// them (narrowphase.c).
     double *normals;
     int normals_current;
+    /// Counts the shapes the collider has stood still in: it grows each
+    /// time the collider comes to rest after moving, so that what was
+    /// measured on a shape (support.h) knows when it no longer holds.
+    int64_t shape;
     /// The collider's path: summed over the committed steps, the largest
     /// displacement of any of its vertices in each; and that displacement
     /// in the step being computed. No vertex has moved farther than the

@@ -9,6 +9,7 @@
 #include "narrowphase.h"
 #include "parallel.h"
 #include "response.h"
+#include "support.h"
 #include "vec3.h"
 
 /* A contact distance of zero would leave a resting particle exactly in the
@@ -36,10 +37,23 @@
 
 struct wc_collider_contacts {
     wc_cloth_elements el;
-    /// Per collider (by index): the candidates; made at first use.
+    /// Per collider (by index): the candidates; made at first use. And its
+    /// support reaches (support.h), measured while it stands still.
     wc_candidates *cand;
+    wc_support *support;
     int32_t cand_count;
-    int use_filter, whole_collider, sharp_only;
+    /// Per particle, two each (collider, triangle; -1 for none): the
+    /// triangle that held it (support.h) at the end of the last committed
+    /// step, which its first test of that collider takes in this step
+    /// (hint), and what holds it in this step (hint_next), which the commit
+    /// makes the hint (hints_due: the stage ran in this step). Likewise a
+    /// triangle that pushed the particle before its reaches were measured
+    /// (want_next; want once committed), measured at the start of the next
+    /// step. A failed step is taken again from the committed hints and
+    /// wants, with the bits of a run that never failed.
+    int32_t *hint, *hint_next, *want, *want_next;
+    int hints_due;
+    int use_filter, whole_collider, sharp_only, use_support;
     /// Between rounds: recheck (the particle pass must test the particle
     /// again) and shifted (the feature pass must visit its elements).
     uint8_t *recheck, *shifted;
@@ -72,8 +86,9 @@ struct wc_collider_contacts {
     int32_t kept_capacity;
     /// Per particle: its motion over the step (start to end, as it is).
     double *motion;
-    /// Exact tests of feature pairs run so far.
-    int64_t feature_tests;
+    /// Exact tests of feature pairs, and of particles against faces, run so
+    /// far.
+    int64_t feature_tests, face_tests;
     /// Whether the last resolve found the cloth apart from every collider
     /// (cloth_apart) and ran no pass: the candidates are then forgotten,
     /// made again when it comes near. use_apart: the test switch; how many
@@ -164,6 +179,7 @@ wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *c)
     size_t n = (size_t)c->particle_count;
     s->use_filter = 1;
     s->use_apart = 1;
+    s->use_support = 1;
     s->el.particle_count = c->particle_count;
     s->el.triangle_count = c->topology.triangle_count;
     s->el.triangles = c->topology.triangles;
@@ -187,20 +203,28 @@ wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *c)
     s->visit_mark = wci_alloc_array(most, 1);
     s->visit_list = wci_alloc_array(most, sizeof *s->visit_list);
     s->motion = wci_alloc_array(n, sizeof *s->motion);
-    if (!ok || !s->motion || !s->recheck || !s->changed || !s->shifted || !s->carry || !s->moved || !s->moving ||
+    s->hint = wci_alloc_array(2 * n, sizeof *s->hint);
+    s->hint_next = wci_alloc_array(2 * n, sizeof *s->hint_next);
+    s->want = wci_alloc_array(2 * n, sizeof *s->want);
+    s->want_next = wci_alloc_array(2 * n, sizeof *s->want_next);
+    if (!ok || !s->motion || !s->hint || !s->hint_next || !s->want || !s->want_next || !s->recheck || !s->changed || !s->shifted || !s->carry || !s->moved || !s->moving ||
         !s->moved_list || !s->moving_list || !s->rebase_list || !s->rebase_flag ||
         !s->visit_mark || !s->visit_list) {
         wci_collider_contacts_destroy(s);
         return NULL;
     }
+    for (size_t k = 0; k < 2 * n; ++k) s->hint[k] = s->hint_next[k] = s->want[k] = s->want_next[k] = -1;
     return s;
 }
 
 void wci_collider_contacts_destroy(wc_collider_contacts *s)
 {
     if (!s) return;
-    for (int32_t k = 0; k < s->cand_count; ++k) wci_candidates_destroy(&s->cand[k]);
-    void *blocks[] = {s->cand, s->el.edges, s->el.triangles_start, s->el.triangles_of,
+    for (int32_t k = 0; k < s->cand_count; ++k) {
+        wci_candidates_destroy(&s->cand[k]);
+        wci_support_destroy(&s->support[k]);
+    }
+    void *blocks[] = {s->cand, s->support, s->hint, s->hint_next, s->want, s->want_next, s->el.edges, s->el.triangles_start, s->el.triangles_of,
                       s->el.edges_start, s->el.edges_of, s->recheck, s->changed, s->shifted, s->carry,
                       s->moved, s->moving, s->moved_list, s->moving_list, s->rebase_list,
                       s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->measured,
@@ -212,6 +236,11 @@ void wci_collider_contacts_destroy(wc_collider_contacts *s)
 void wci_collider_contacts_commit(wc_collider_contacts *s, int32_t particle_count)
 {
     for (int32_t k = 0; k < s->cand_count; ++k) wci_candidates_commit(&s->cand[k], particle_count);
+    if (s->hints_due) {
+        memcpy(s->hint, s->hint_next, 2 * (size_t)particle_count * sizeof *s->hint);
+        memcpy(s->want, s->want_next, 2 * (size_t)particle_count * sizeof *s->want);
+    }
+    s->hints_due = 0;
 }
 
 void wci_collider_contacts_use_filter(wc_collider_contacts *s, int use) { s->use_filter = use; }
@@ -235,6 +264,10 @@ void wci_collider_contacts_use_apart(wc_collider_contacts *s, int use) { s->use_
 int64_t wci_collider_contacts_apart_steps(const wc_collider_contacts *s) { return s->apart_steps; }
 
 int64_t wci_collider_contacts_feature_tests(const wc_collider_contacts *s) { return s->feature_tests; }
+
+void wci_collider_contacts_use_support(wc_collider_contacts *s, int use) { s->use_support = use; }
+
+int64_t wci_collider_contacts_face_tests(const wc_collider_contacts *s) { return s->face_tests; }
 
 int32_t wci_collider_contacts_uncovered(const wc_collider_contacts *s, const wc_cloth *c)
 {
@@ -266,11 +299,19 @@ static int grow_candidates(wc_collider_contacts *s, int32_t count)
 {
     if (count <= s->cand_count) return 1;
     wc_candidates *grown = wci_alloc_array((size_t)count, sizeof *grown);
-    if (!grown) return 0;
-    if (s->cand_count) memcpy(grown, s->cand, (size_t)s->cand_count * sizeof *grown);
-    for (int32_t k = s->cand_count; k < count; ++k) memset(&grown[k], 0, sizeof grown[k]);
-    wci_free(s->cand);
-    s->cand = grown, s->cand_count = count;
+    wc_support *support = wci_alloc_array((size_t)count, sizeof *support);
+    if (!grown || !support) {
+        wci_free(grown), wci_free(support);
+        return 0;
+    }
+    memset(grown, 0, (size_t)count * sizeof *grown);
+    memset(support, 0, (size_t)count * sizeof *support);
+    if (s->cand_count) {
+        memcpy(grown, s->cand, (size_t)s->cand_count * sizeof *grown);
+        memcpy(support, s->support, (size_t)s->cand_count * sizeof *support);
+    }
+    wci_free(s->cand), wci_free(s->support);
+    s->cand = grown, s->support = support, s->cand_count = count;
     return 1;
 }
 
@@ -315,6 +356,7 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
         } else {
             wci_candidates_local_motion(cand, &s->el, col, threads);
         }
+        if (!col->moving && wci_support_prepare(&s->support[k], col, r)) return WC_ERROR_OUT_OF_MEMORY;
         for (int32_t i = 0; i < c->particle_count; ++i)
             if (wc_candidates_rebase_due(cand, i, wci_candidates_displacement(cand, p, i)))
                 note_rebase(s, i);
@@ -336,6 +378,13 @@ typedef struct particle_run {
     int touched;
     double last_motion[3];
     int leaves_cover;
+    /// The collider (index, -1 for none) and its triangle that hold the
+    /// particle at held_end (support.h), found in this round; and one whose
+    /// reach was wanted for that but not yet measured (2 t + side).
+    int32_t held_by, held_triangle, want_by, want_triangle;
+    double held_end[3];
+    /// Exact tests run.
+    int64_t tests;
 } particle_run;
 
 static void end_now(const particle_run *run, double end[3])
@@ -358,6 +407,33 @@ static int answer_particle(particle_run *run, wc_contact *k, const wc_collider *
     return 1;
 }
 
+/* Whether triangle t of collider k holds the particle where it is now
+ * (support.h): then no triangle of that collider can touch it until it
+ * moves again, and the hint for the next step is t. */
+static int held(particle_run *run, const wc_support *support, const wc_collider *col, int32_t k, int32_t t)
+{
+    double end[3];
+    end_now(run, end);
+    int side = wci_support_side(col, t, run->start);
+    if (!wci_support_measured(support, t, side)) {
+        run->want_by = k, run->want_triangle = 2 * t + side;
+        return 0;
+    }
+    if (!wci_support_holds(support, col, t, run->start, end)) return 0;
+    run->held_by = k, run->held_triangle = t;
+    memcpy(run->held_end, end, sizeof end);
+    return 1;
+}
+
+/* Whether the particle is still where a collider held it. */
+static int still_held(const particle_run *run, int32_t k)
+{
+    const wc_particle_arrays *p = run->p;
+    int32_t i = run->i;
+    return run->held_by == k && p->nx[i] == run->held_end[0] && p->ny[i] == run->held_end[1] &&
+           p->nz[i] == run->held_end[2];
+}
+
 /* Triangle t against the particle's motion as it is now; *end_d2 gets a
  * lower bound on the square of their distance at the end of the step
  * (wci_narrow_particle_triangle). */
@@ -366,6 +442,7 @@ static int test_triangle(particle_run *run, const wc_collider *col, int32_t t, d
     double end[3];
     wc_contact k;
     end_now(run, end);
+    ++run->tests;
     if (!wci_narrow_particle_triangle(col, t, run->i, run->start, end, r, end_d2, &k)) return 0;
     return answer_particle(run, &k, col);
 }
@@ -525,16 +602,28 @@ static void renew_particle(const wc_candidates *cand, const wc_particle_arrays *
 /* One mesh collider against the particle: the items of its list that the
  * filter keeps (candidates.h), in turn, with the bound measured from the
  * list's snapshot; the visit then renews the snapshot. */
-static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_collider *col,
-                         double r, int use_filter)
+static int mesh_particle(particle_run *run, const wc_collider_contacts *s, int32_t k,
+                         const wc_collider *col, double r)
 {
     const wc_particle_arrays *p = run->p;
+    const wc_candidates *cand = &s->cand[k];
     const wc_pair_lists *l = &cand->particles;
     int32_t i = run->i, after = -1, stack[DIRECT_STACK], *kept = stack, room = DIRECT_STACK;
+    if (still_held(run, k)) return 0;
+    const wc_support *support =
+        s->use_support && wci_support_ready(&s->support[k], col, r) ? &s->support[k] : NULL;
+    int moved = 0, use_filter = s->use_filter;
+    const int32_t *hint = s->hint + 2 * (size_t)i;
+    if (support && hint[0] == k && hint[1] < col->triangle_count) {
+        /* the triangle that held the particle at the last step first: on a
+         * convex collider it holds it again, and nothing else is tested */
+        double unused;
+        moved = test_triangle(run, col, hint[1], r, &unused);
+        if (held(run, support, col, k, hint[1])) return moved;
+    }
     double drift = wc_candidates_path_now(cand, i) - l->path_at[i];
     particle_measures m;
     m.n = 0, m.moved = 0.0, m.rest = INFINITY, m.complete = use_filter;
-    int moved = 0;
     for (;;) {
         double d = wci_candidates_displacement(cand, p, i);
         if (!wc_candidates_covers(cand, i, d)) {
@@ -592,6 +681,10 @@ static int mesh_particle(particle_run *run, const wc_candidates *cand, const wc_
         }
         if (pushed < 0) break;
         moved = 1, after = pushed;
+        if (support && held(run, support, col, k, pushed)) {
+            m.complete = 0; /* the items after it were not measured */
+            break;
+        }
         double shift[3] = {p->nx[i] - before[0], p->ny[i] - before[1], p->nz[i] - before[2]};
         m.moved += sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]);
     }
@@ -614,7 +707,7 @@ static int particle_passes(wc_collider_contacts *s, const wc_cloth *c, wc_collid
             const wc_collider *col = colliders[k];
             double r = contact_distance(c, col);
             if (col->is_mesh) {
-                moved |= mesh_particle(run, &s->cand[k], col, r, s->use_filter);
+                moved |= mesh_particle(run, s, k, col, r);
             } else {
                 double end[3];
                 wc_contact ct;
@@ -632,9 +725,10 @@ static int32_t particle_pass(wc_collider_contacts *s, wc_cloth *c, const wc_part
                              wc_collider *const *colliders, int32_t count, int threads, int all)
 {
     int32_t n = c->particle_count, failsafe = 0;
+    int64_t tests = 0;
     (void)threads;
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads) if (n >= WC_PARALLEL_MIN) \
-    reduction(+ : failsafe)
+    reduction(+ : failsafe, tests)
     for (int32_t i = 0; i < n; ++i) {
         if (c->pin_slot[i] >= 0 || !(all || s->recheck[i])) continue;
         s->recheck[i] = 0;
@@ -642,9 +736,12 @@ static int32_t particle_pass(wc_collider_contacts *s, wc_cloth *c, const wc_part
         run.p = p, run.i = i;
         run.start[0] = c->x[i], run.start[1] = c->y[i], run.start[2] = c->z[i];
         run.mu_cloth = c->material.friction, run.q = c->material.wet_friction;
-        run.touched = 0, run.leaves_cover = 0;
+        run.touched = 0, run.leaves_cover = 0, run.held_by = -1, run.want_by = -1, run.tests = 0;
         run.last_motion[0] = run.last_motion[1] = run.last_motion[2] = 0.0;
         int stuck = particle_passes(s, c, colliders, count, &run);
+        tests += run.tests;
+        if (run.held_by >= 0) s->hint_next[2 * (size_t)i] = run.held_by, s->hint_next[2 * (size_t)i + 1] = run.held_triangle;
+        if (run.want_by >= 0) s->want_next[2 * (size_t)i] = run.want_by, s->want_next[2 * (size_t)i + 1] = run.want_triangle;
         if (!run.touched) continue;
         if (stuck) {
             /* Still pushed around after every pass: wedged between
@@ -663,6 +760,7 @@ static int32_t particle_pass(wc_collider_contacts *s, wc_cloth *c, const wc_part
         s->shifted[i] = 1;
         track(s, p, i);
     }
+    s->face_tests += tests;
     return failsafe;
 }
 
@@ -1005,6 +1103,23 @@ static int cloth_apart(const wc_cloth *c, const wc_particle_arrays *p, wc_collid
     return 1;
 }
 
+/* The reaches the last committed step wanted (support.h), measured before
+ * the passes: a step taken again finds them as its first try did. */
+static void measure_wanted(wc_collider_contacts *s, const wc_cloth *c, wc_collider *const *colliders,
+                           int32_t count)
+{
+    for (int32_t i = 0; i < c->particle_count; ++i) {
+        int32_t k = s->want[2 * (size_t)i], t = s->want[2 * (size_t)i + 1] / 2;
+        int side = s->want[2 * (size_t)i + 1] % 2;
+        if (k < 0 || k >= count) continue;
+        const wc_collider *col = colliders[k];
+        wc_support *support = &s->support[k];
+        if (col->is_mesh && t < col->triangle_count && wci_support_ready(support, col, contact_distance(c, col)) &&
+            !wci_support_measured(support, t, side))
+            wci_support_measure(support, col, t, side);
+    }
+}
+
 /* The stage over every particle: their motions noted, the lists made or
  * brought up to date, the passes. */
 static wc_status whole_stage(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
@@ -1014,6 +1129,7 @@ static wc_status whole_stage(wc_collider_contacts *s, wc_cloth *c, const wc_part
     for (int32_t i = 0; i < c->particle_count; ++i) track(s, p, i);
     memset(s->changed, 0, (size_t)c->particle_count);
     if (refresh_candidates(s, c, colliders, count, p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
+    measure_wanted(s, c, colliders, count);
     int32_t failsafe = 0;
     wc_status status = pass_rounds(s, c, p, colliders, count, steps_left, threads, 1, NULL, &failsafe);
     stats->failsafe_particles += failsafe;
@@ -1030,6 +1146,8 @@ wc_status wci_collider_contacts_resolve(wc_cloth *c, wc_collider_contacts *s,
      * than it to stay so: a cloth moving about that distance from a
      * collider does not make its lists again at every step. (A little over
      * 1 covers the rounding of the box's differences.) */
+    for (int32_t j = 0; j < 2 * c->particle_count; ++j) s->hint_next[j] = s->want_next[j] = -1;
+    s->hints_due = 1;
     s->apart = s->use_apart && cloth_apart(c, &p, colliders, count, s->apart ? APART_STAYS : APART_BECOMES);
     if (!s->apart) return whole_stage(s, c, &p, colliders, count, steps_left, threads, stats);
     /* lists that no step keeps up to date: made again when it comes near */

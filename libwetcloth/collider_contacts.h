@@ -60,7 +60,8 @@ wc_status wci_collider_contacts_recheck(wc_cloth *cloth, wc_collider_contacts *s
                                        wc_step_stats *stats, const uint8_t **changed);
 
 /// After a committed step: the candidates' local paths take the step's
-/// local motion (candidates.h).
+/// local motion (candidates.h), and the triangles that held particles
+/// become their hints for the next step (support.h).
 void wci_collider_contacts_commit(wc_collider_contacts *state, int32_t particle_count);
 
 /// For tests: 0 bounds the collider's motion near every particle by its
@@ -97,6 +98,15 @@ int64_t wci_collider_contacts_apart_steps(const wc_collider_contacts *state);
 /// triangle, collider edge against cloth edge) the stage has run so far:
 /// what the filter left (tests/test_collide.c).
 int64_t wci_collider_contacts_feature_tests(const wc_collider_contacts *state);
+
+/// Test switch: 1 (default) lets a static mesh collider's triangle that
+/// holds a particle (support.h) answer for the whole collider, and tests it
+/// first at the next step; 0 tests every triangle the filter keeps.
+void wci_collider_contacts_use_support(wc_collider_contacts *state, int use);
+
+/// How many exact tests of a particle against a collider face the stage has
+/// run so far (tests).
+int64_t wci_collider_contacts_face_tests(const wc_collider_contacts *state);
 
 /// A test's check of the candidates' invariant: how many particles of the
 /// cloth are, against some mesh collider, farther from their lists' cover

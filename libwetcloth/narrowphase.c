@@ -154,7 +154,7 @@ static int static_apart(const wc_collider *c, int32_t t, const double end[3], do
     double e[3][3];
     for (int k = 0; k < 3; ++k) vertex_of(c->next, c->triangles[3 * (size_t)t + k], e[k]);
     *d2 = wci_point_triangle_closest(end, e[0], e[1], e[2], w);
-    return !(*d2 < r * r * (1.0 - 1e-9));
+    return !(*d2 < r * r * (1.0 - WC_FACE_SLACK));
 }
 
 int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t particle,
@@ -198,9 +198,7 @@ int wci_narrow_particle_triangle(const wc_collider *c, int32_t t, int32_t partic
     bary_point(t1[0], t1[1], t1[2], w, cp);
     for (int k = 0; k < 3; ++k) offset[k] = end[k] - cp[k];
     double side = side_of(start, t0[0], n0, offset, n1);
-    /* A particle the last pass put at distance r may sit a rounding error
-     * inside it; the slack keeps it from counting as a new contact. */
-    int hit = d2 < r * r * (1.0 - 1e-9);
+    int hit = d2 < r * r * (1.0 - WC_FACE_SLACK);
     /* Crossed the surface during the step (possibly far through it): the
      * contact is placed where the particle met the triangle, on the
      * end-of-step triangle. */

@@ -24,6 +24,11 @@
 #include "collider.h"
 #include "response.h"
 
+/// A particle counts as touching a collider face only nearer than
+/// r sqrt(1 - WC_FACE_SLACK): a particle the last pass put at distance r may
+/// sit a rounding error inside it, and must not count as a new contact.
+#define WC_FACE_SLACK 1e-9
+
 /// A contact counts for the feature tests only if it is deeper than this
 /// fraction of the contact distance: where a collider corner and its edges
 /// push the same cloth element in turn, what is left shrinks geometrically
