@@ -455,7 +455,12 @@ static int test_triangle(particle_run *run, const wc_collider *col, int32_t t, d
  * every item of the collider were tested in turn against the state as it is
  * then: the lists and the filter only leave out items that cannot touch at
  * their turn. After a push the particle has moved, so the items after the
- * one that pushed are gathered again with the new bound. */
+ * one that pushed are gathered again with the new bound. Against a static
+ * mesh collider, the triangle that held the particle at the last committed
+ * step goes first, and a triangle that holds it (support.h) ends its tests
+ * of that collider: no other triangle can touch it then. Which triangle that
+ * is depends only on the committed state and the step's own motion, never on
+ * the candidates'. */
 
 /* Gathers position j of a list into out if its bound d is within `bound`,
  * and otherwise lowers *least to d; returns the new count. */
