@@ -207,9 +207,9 @@ wc_collider_contacts *wci_collider_contacts_create(const wc_cloth *c)
     s->hint_next = wci_alloc_array(2 * n, sizeof *s->hint_next);
     s->want = wci_alloc_array(2 * n, sizeof *s->want);
     s->want_next = wci_alloc_array(2 * n, sizeof *s->want_next);
-    if (!ok || !s->motion || !s->hint || !s->hint_next || !s->want || !s->want_next || !s->recheck || !s->changed || !s->shifted || !s->carry || !s->moved || !s->moving ||
+    if (!ok || !s->motion || !s->recheck || !s->changed || !s->shifted || !s->carry || !s->moved || !s->moving ||
         !s->moved_list || !s->moving_list || !s->rebase_list || !s->rebase_flag ||
-        !s->visit_mark || !s->visit_list) {
+        !s->visit_mark || !s->visit_list || !s->hint || !s->hint_next || !s->want || !s->want_next) {
         wci_collider_contacts_destroy(s);
         return NULL;
     }
@@ -224,7 +224,8 @@ void wci_collider_contacts_destroy(wc_collider_contacts *s)
         wci_candidates_destroy(&s->cand[k]);
         wci_support_destroy(&s->support[k]);
     }
-    void *blocks[] = {s->cand, s->support, s->hint, s->hint_next, s->want, s->want_next, s->el.edges, s->el.triangles_start, s->el.triangles_of,
+    void *blocks[] = {s->cand, s->support, s->hint, s->hint_next, s->want, s->want_next,
+                      s->el.edges, s->el.triangles_start, s->el.triangles_of,
                       s->el.edges_start, s->el.edges_of, s->recheck, s->changed, s->shifted, s->carry,
                       s->moved, s->moving, s->moved_list, s->moving_list, s->rebase_list,
                       s->rebase_flag, s->visit_mark, s->visit_list, s->kept, s->measured,
@@ -604,9 +605,11 @@ static void renew_particle(const wc_candidates *cand, const wc_particle_arrays *
                         wci_candidates_ceiling(cand, cand->r, &i, 1, p));
 }
 
-/* One mesh collider against the particle: the items of its list that the
- * filter keeps (candidates.h), in turn, with the bound measured from the
- * list's snapshot; the visit then renews the snapshot. */
+/* One mesh collider against the particle: first the triangle that held it
+ * at the last committed step, then the items of its list that the filter
+ * keeps (candidates.h), in turn, with the bound measured from the list's
+ * snapshot, until a triangle holds it (support.h); a visit that measured
+ * the whole list renews the snapshot. */
 static int mesh_particle(particle_run *run, const wc_collider_contacts *s, int32_t k,
                          const wc_collider *col, double r)
 {
@@ -726,6 +729,15 @@ static int particle_passes(wc_collider_contacts *s, const wc_cloth *c, wc_collid
     return moved;
 }
 
+/* What held the particle in this step, and what it wanted measured, for
+ * the commit to keep (touches only particle run->i's entries). */
+static void note_hints(wc_collider_contacts *s, const particle_run *run)
+{
+    int32_t *hint = s->hint_next + 2 * (size_t)run->i, *want = s->want_next + 2 * (size_t)run->i;
+    if (run->held_by >= 0) hint[0] = run->held_by, hint[1] = run->held_triangle;
+    if (run->want_by >= 0) want[0] = run->want_by, want[1] = run->want_triangle;
+}
+
 static int32_t particle_pass(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
                              wc_collider *const *colliders, int32_t count, int threads, int all)
 {
@@ -745,8 +757,7 @@ static int32_t particle_pass(wc_collider_contacts *s, wc_cloth *c, const wc_part
         run.last_motion[0] = run.last_motion[1] = run.last_motion[2] = 0.0;
         int stuck = particle_passes(s, c, colliders, count, &run);
         tests += run.tests;
-        if (run.held_by >= 0) s->hint_next[2 * (size_t)i] = run.held_by, s->hint_next[2 * (size_t)i + 1] = run.held_triangle;
-        if (run.want_by >= 0) s->want_next[2 * (size_t)i] = run.want_by, s->want_next[2 * (size_t)i + 1] = run.want_triangle;
+        note_hints(s, &run);
         if (!run.touched) continue;
         if (stuck) {
             /* Still pushed around after every pass: wedged between
@@ -1119,8 +1130,8 @@ static void measure_wanted(wc_collider_contacts *s, const wc_cloth *c, wc_collid
         if (k < 0 || k >= count) continue;
         const wc_collider *col = colliders[k];
         wc_support *support = &s->support[k];
-        if (col->is_mesh && t < col->triangle_count && wci_support_ready(support, col, contact_distance(c, col)) &&
-            !wci_support_measured(support, t, side))
+        if (!col->is_mesh || t >= col->triangle_count) continue;
+        if (wci_support_ready(support, col, contact_distance(c, col)) && !wci_support_measured(support, t, side))
             wci_support_measure(support, col, t, side);
     }
 }

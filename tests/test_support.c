@@ -237,8 +237,9 @@ static int32_t holds_by_brute_force(const mesh *m, double r, int32_t tries, cons
         ++held;
         for (int32_t q = 0; q < c->triangle_count; ++q) {
             double bary[3];
-            double d2 = wci_point_triangle_closest(end, corner(c, q, 0), corner(c, q, 1), corner(c, q, 2), bary);
-            int meets = segment_meets(start, end, corner(c, q, 0), corner(c, q, 1), corner(c, q, 2));
+            const double *a = corner(c, q, 0), *b = corner(c, q, 1), *d = corner(c, q, 2);
+            double d2 = wci_point_triangle_closest(end, a, b, d, bary);
+            int meets = segment_meets(start, end, a, b, d);
             if ((d2 < r * r * (1.0 - WC_FACE_SLACK) || meets) && bad++ < 3)
                 CHECK(0, "%s: a path held by triangle %d %s triangle %d (distance %.17g, r %.17g)", name,
                       (int)t, meets ? "meets" : "ends too near", (int)q, sqrt(d2), r);
@@ -308,7 +309,10 @@ static void drop_both_ways(const mesh *m, double top, int frames, double least_s
 {
     drop_result with = drop(m, top, 1, frames), without = drop(m, top, 0, frames);
     double rms = 0.0;
-    for (int k = 0; k < 3 * 400; ++k) rms += (with.positions[k] - without.positions[k]) * (with.positions[k] - without.positions[k]);
+    for (int k = 0; k < 3 * 400; ++k) {
+        double d = with.positions[k] - without.positions[k];
+        rms += d * d;
+    }
     rms = sqrt(rms / 400);
     printf("%s: %lld face tests with supports, %lld without; nearest particle %.9f r and %.9f r; "
            "drapes %.2e m apart\n", name, (long long)with.face_tests, (long long)without.face_tests,
