@@ -7,11 +7,11 @@
  * all lie on or behind that plane: such a triangle is no nearer to the end
  * than the plane, and the path, in front of the plane all along, never meets
  * it. On a convex collider that is every triangle, so one test answers for
- * the whole collider, where the particle pass otherwise tests every
+ * the whole collider where the particle pass would otherwise test every
  * triangle the filter keeps: on the 30,624-triangle sphere at Blender's
  * collider thickness (r = 0.02 m against 1 cm triangles) a resting
- * particle has 5-7 triangles within a tenth of a millimetre of r, and each
- * is tested at every step.
+ * particle has 5-7 triangles within a tenth of a millimetre of r, which
+ * the filter cannot leave out.
  *
  * For each triangle and each side of its plane, the reach is the least
  * distance from the triangle of a collider vertex beyond the plane on that
@@ -21,9 +21,10 @@
  * path stays within reach - longest_edge - r of t has nothing to touch
  * there either (wci_support_holds). The reaches are measured up to a cap,
  * from the contact distance: a convex collider's front reaches are the cap.
- * The contact stage measures a triangle's when it first pushes a particle,
- * at the start of the next step (so that a step taken again sees what the
- * first try saw), and from then on tests it first for that particle.
+ * The contact stage measures a triangle's reach when the triangle first
+ * pushes a particle, at the start of the next step (so that a step taken
+ * again sees what the first try saw); a triangle that held a particle is
+ * the first it tests for that particle at the next step.
  *
  * A moving collider has none (its shape changes within the step); one at
  * rest again has them measured again for its new shape (wc_collider.shape). */
