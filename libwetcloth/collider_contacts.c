@@ -378,7 +378,6 @@ typedef struct particle_run {
     double mu_cloth, q;
     int touched;
     double last_motion[3];
-    int leaves_cover;
     /// The collider (index, -1 for none) and its triangle that hold the
     /// particle at held_end (support.h), found in this round; and one whose
     /// reach was wanted for that but not yet measured (2 t + side).
@@ -635,7 +634,6 @@ static int mesh_particle(particle_run *run, const wc_collider_contacts *s, int32
     for (;;) {
         double d = wci_candidates_displacement(cand, p, i);
         if (!wc_candidates_covers(cand, i, d)) {
-            run->leaves_cover = 1;
             m.complete = 0;
             moved |= direct_triangles(run, col, r, after);
             break;
@@ -753,7 +751,7 @@ static int32_t particle_pass(wc_collider_contacts *s, wc_cloth *c, const wc_part
         run.p = p, run.i = i;
         run.start[0] = c->x[i], run.start[1] = c->y[i], run.start[2] = c->z[i];
         run.mu_cloth = c->material.friction, run.q = c->material.wet_friction;
-        run.touched = 0, run.leaves_cover = 0, run.held_by = -1, run.want_by = -1, run.tests = 0;
+        run.touched = 0, run.held_by = -1, run.want_by = -1, run.tests = 0;
         run.last_motion[0] = run.last_motion[1] = run.last_motion[2] = 0.0;
         int stuck = particle_passes(s, c, colliders, count, &run);
         tests += run.tests;

@@ -57,30 +57,38 @@ static mesh sphere_mesh(double radius, int32_t segments, int32_t rings)
     return m;
 }
 
+/* A flat square of side 2 half at z = 0, centred at the origin, of
+ * cells x cells squares of two triangles each. */
+static mesh flat_grid(int32_t cells, double half)
+{
+    mesh m;
+    m.nv = (cells + 1) * (cells + 1), m.nt = 2 * cells * cells;
+    m.v = malloc(3 * (size_t)m.nv * sizeof *m.v);
+    m.t = malloc(3 * (size_t)m.nt * sizeof *m.t);
+    if (!m.v || !m.t) exit(test_report("test_support"));
+    for (int j = 0; j <= cells; ++j)
+        for (int i = 0; i <= cells; ++i) {
+            double *p = m.v + 3 * (size_t)(j * (cells + 1) + i);
+            p[0] = -half + 2.0 * half * i / cells, p[1] = -half + 2.0 * half * j / cells, p[2] = 0.0;
+        }
+    for (int32_t j = 0, k = 0; j < cells; ++j)
+        for (int32_t i = 0; i < cells; ++i) {
+            int32_t a = j * (cells + 1) + i, b = a + 1, c = a + cells + 1, d = c + 1;
+            m.t[k++] = a, m.t[k++] = b, m.t[k++] = d, m.t[k++] = a, m.t[k++] = d, m.t[k++] = c;
+        }
+    return m;
+}
+
 /* A 0.8 m square of ground, with a bump of `bump` m and a groove along y,
  * 6 cm deep and 12 cm wide (a concave collider). */
 static mesh ground_mesh(double bump)
 {
-    mesh m;
-    m.nv = (GROUND_N + 1) * (GROUND_N + 1), m.nt = 2 * GROUND_N * GROUND_N;
-    m.v = malloc(3 * (size_t)m.nv * sizeof *m.v);
-    m.t = malloc(3 * (size_t)m.nt * sizeof *m.t);
-    if (!m.v || !m.t) exit(test_report("test_support"));
-    for (int j = 0; j <= GROUND_N; ++j)
-        for (int i = 0; i <= GROUND_N; ++i) {
-            double x = -0.4 + 0.8 * i / GROUND_N, y = -0.4 + 0.8 * j / GROUND_N;
-            double *p = m.v + 3 * (size_t)(j * (GROUND_N + 1) + i);
-            double groove = fabs(x + 0.15) < 0.06 ? -0.06 * (1.0 - fabs(x + 0.15) / 0.06) : 0.0;
-            p[0] = x, p[1] = y;
-            p[2] = groove + bump * exp(-((x - 0.15) * (x - 0.15) + y * y) / (2 * 0.08 * 0.08));
-        }
-    int32_t nt = 0;
-    for (int j = 0; j < GROUND_N; ++j)
-        for (int i = 0; i < GROUND_N; ++i) {
-            int32_t a = j * (GROUND_N + 1) + i, b = a + 1, c = a + GROUND_N + 1, d = c + 1;
-            m.t[3 * nt] = a, m.t[3 * nt + 1] = b, m.t[3 * nt + 2] = d, ++nt;
-            m.t[3 * nt] = a, m.t[3 * nt + 1] = d, m.t[3 * nt + 2] = c, ++nt;
-        }
+    mesh m = flat_grid(GROUND_N, 0.4);
+    for (int32_t k = 0; k < m.nv; ++k) {
+        double *p = m.v + 3 * (size_t)k, x = p[0], y = p[1];
+        double groove = fabs(x + 0.15) < 0.06 ? -0.06 * (1.0 - fabs(x + 0.15) / 0.06) : 0.0;
+        p[2] = groove + bump * exp(-((x - 0.15) * (x - 0.15) + y * y) / (2 * 0.08 * 0.08));
+    }
     return m;
 }
 
@@ -89,14 +97,22 @@ static void mesh_free(mesh *m)
     free(m->v), free(m->t);
 }
 
-static int32_t add_mesh(wc_world *w, const mesh *m)
+/* The mesh as a collider of the tests' thickness and the given friction
+ * (negative: the default). */
+static int32_t add_mesh_with(wc_world *w, const mesh *m, double friction)
 {
     wc_mesh_collider_def d = wc_mesh_collider_def_default();
     d.vertices = m->v, d.vertex_count = m->nv, d.triangles = m->t, d.triangle_count = m->nt;
     d.thickness = THICKNESS;
+    if (friction >= 0.0) d.friction = friction;
     int32_t col = -1;
     CHECK(wc_world_add_mesh_collider(w, &d, &col) == WC_OK, "%s", wc_world_last_error(w));
     return col;
+}
+
+static int32_t add_mesh(wc_world *w, const mesh *m)
+{
+    return add_mesh_with(w, m, -1.0);
 }
 
 static const double *corner(const wc_collider *c, int32_t t, int k)
@@ -388,26 +404,8 @@ static double slide(int32_t cells, int support, double theta, double mu, double 
     def.thread_count = 1;
     def.gravity[0] = 9.81 * sin(theta), def.gravity[1] = 0.0, def.gravity[2] = -9.81 * cos(theta);
     wc_world *w = scene_world_from(&def);
-    mesh m;
-    m.nv = (cells + 1) * (cells + 1), m.nt = 2 * cells * cells;
-    m.v = malloc(3 * (size_t)m.nv * sizeof *m.v);
-    m.t = malloc(3 * (size_t)m.nt * sizeof *m.t);
-    if (!m.v || !m.t) exit(test_report("test_support"));
-    for (int j = 0; j <= cells; ++j)
-        for (int i = 0; i <= cells; ++i) {
-            double *p = m.v + 3 * (size_t)(j * (cells + 1) + i);
-            p[0] = -1.0 + 2.0 * i / cells, p[1] = -1.0 + 2.0 * j / cells, p[2] = 0.0;
-        }
-    for (int32_t j = 0, k = 0; j < cells; ++j)
-        for (int32_t i = 0; i < cells; ++i) {
-            int32_t a = j * (cells + 1) + i, b = a + 1, c = a + cells + 1, d = c + 1;
-            m.t[k++] = a, m.t[k++] = b, m.t[k++] = d, m.t[k++] = a, m.t[k++] = d, m.t[k++] = c;
-        }
-    wc_mesh_collider_def cd = wc_mesh_collider_def_default();
-    cd.vertices = m.v, cd.vertex_count = m.nv, cd.triangles = m.t, cd.triangle_count = m.nt;
-    cd.thickness = THICKNESS, cd.friction = mu;
-    int32_t col;
-    CHECK(wc_world_add_mesh_collider(w, &cd, &col) == WC_OK, "%s", wc_world_last_error(w));
+    mesh m = flat_grid(cells, 1.0);
+    add_mesh_with(w, &m, mu);
     wc_grid_cloth_def g = wc_grid_cloth_def_default();
     g.count_u = g.count_v = 5;
     g.size_u = g.size_v = 0.1;
