@@ -145,9 +145,10 @@ typedef struct wc_world_def {
     /// 1 (about g / 10): on the thesis drape it leaves the error against a
     /// fine-step reference solved to round-off where it was, at about 4x fewer
     /// iterations. Larger values are faster still and leave the drape as
-    /// close, but not a cloth sliding with friction: the solve's error at the
-    /// contacts becomes friction, and at 2 a small cloth on a slope slid 3 %
-    /// short of the closed form (at 1: 1.4 %; docs/model.md has the figures).
+    /// close, but not a sliding cloth: the solve's error leaves a stray
+    /// acceleration in the slide, and at 2 a small cloth on a slope with
+    /// friction slid 3 % short of the closed form (at 1: 1.4 %;
+    /// docs/model.md has the figures).
     double implicit_tolerance;
     /// 1 (default): the world times its steps and runs them on fewer than
     /// thread_count threads whenever that is faster: when other programs
