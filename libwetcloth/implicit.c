@@ -34,11 +34,14 @@
 /* Dot products sum fixed blocks of this many particles, then the blocks in
  * order: the same rounding for any thread count. */
 #define BLOCK 512
-/* The sets of partial sums: r . r (and b . b), p . A p, r . z. */
+/* The sets of partial sums: r . r (and b . b), p . A p, r . z, and the
+ * residual's x, y and z summed over the particles (the translation's share
+ * of it, for a cloth without coarse levels). */
 #define PARTIAL_RR 0
 #define PARTIAL_PQ 1
 #define PARTIAL_RZ 2
-#define PARTIAL_SETS 3
+#define PARTIAL_RX 3
+#define PARTIAL_SETS 6
 
 struct wc_implicit_state {
     int32_t n, links, blocks;
@@ -55,7 +58,8 @@ struct wc_implicit_state {
     /// new one while the coarse levels read the old one), preconditioned
     /// residual, search direction, matrix times direction.
     double *v0, *fixed, *rhs, *y, *r, *r_next, *z, *p, *q;
-    /// Per block, the sums of the dot products: three sets (PARTIAL_*), so
+    /// Per block, the sums of the dot products and of the residual: sets
+    /// (PARTIAL_*) of their own, so
     /// that a thread that starts the next sum cannot overwrite one that
     /// another thread has not yet added up.
     double *partial;
@@ -78,6 +82,10 @@ struct wc_implicit_state {
     /// The preconditioner's coarse levels; NULL for a cloth too small to
     /// gain from them (multigrid.h).
     wc_multigrid *multigrid;
+    /// Without coarse levels: the inverse of the matrix's restriction to
+    /// the translations of the free particles together (6 values), with
+    /// which the preconditioner solves for the cloth's motion as a whole.
+    double translation_inverse[6];
     int32_t last_iterations;
     double last_residual;
 };
@@ -186,8 +194,12 @@ typedef struct implicit_pass {
      * particle's aggregate, NULL without coarse levels */
     const double *coarse;
     const int32_t *aggregate;
-    /* where a summing loop puts its per-block sums */
-    double *partial;
+    /* where a summing loop puts its per-block sums, and where the loops that
+     * make a residual put its components' sums (NULL: not needed) */
+    double *partial, *residual_sums;
+    /* precondition, without coarse levels: the translation's correction,
+     * added at every free particle */
+    double translation[3];
     /* the solve's residual and where its update goes (they swap) */
     double *r, *r_next;
 } implicit_pass;
@@ -476,8 +488,9 @@ static int apply_range(void *context, int64_t first, int64_t last)
 
 /* z = the preconditioner times r: the block-Jacobi step, plus on a large
  * cloth the coarse levels' correction of each free particle's aggregate
- * (solved before this pass: wci_multigrid_coarse_solve). Sums r . z. One
- * pass for the three, so that r and z are read once per iteration. */
+ * (solved before this pass: wci_multigrid_coarse_solve), on a smaller one
+ * the translation's (pass->translation). Sums r . z. One pass for the
+ * three, so that r and z are read once per iteration. */
 static int precondition_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
@@ -496,6 +509,9 @@ static int precondition_range(void *context, int64_t first, int64_t last)
             if (coarse && pin_slot[i] < 0) {
                 const double *xc = coarse + 3 * (size_t)aggregate[i];
                 zi[0] += xc[0], zi[1] += xc[1], zi[2] += xc[2];
+            } else if (!coarse && pin_slot[i] < 0) {
+                const double *t = pass->translation;
+                zi[0] += t[0], zi[1] += t[1], zi[2] += t[2];
             }
             sum += ri[0] * zi[0];
             sum += ri[1] * zi[1];
@@ -506,7 +522,15 @@ static int precondition_range(void *context, int64_t first, int64_t last)
     return 0;
 }
 
-/* The solve's start, y = 0 and r = b; sums b . b. */
+/* A block's residual components summed, where the pass wants them. */
+static void put_residual_sums(const implicit_pass *pass, int64_t block, const double sum[3])
+{
+    if (!pass->residual_sums) return;
+    int32_t blocks = pass->state->blocks;
+    for (int m = 0; m < 3; ++m) pass->residual_sums[(size_t)m * (size_t)blocks + (size_t)block] = sum[m];
+}
+
+/* The solve's start, y = 0 and r = b; sums b . b (and b's components). */
 static int start_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
@@ -514,18 +538,23 @@ static int start_range(void *context, int64_t first, int64_t last)
     for (int64_t block = first; block < last; ++block) {
         int64_t begin, end;
         block_bounds(s, block, &begin, &end);
-        double sum = 0.0;
-        for (int64_t i = 3 * begin; i < 3 * end; ++i) {
-            s->y[i] = 0.0;
-            pass->r[i] = s->rhs[i];
-            sum += s->rhs[i] * s->rhs[i];
-        }
+        double sum = 0.0, components[3] = {0.0, 0.0, 0.0};
+        for (int64_t k = begin; k < end; ++k)
+            for (int m = 0; m < 3; ++m) {
+                int64_t i = 3 * k + m;
+                s->y[i] = 0.0;
+                pass->r[i] = s->rhs[i];
+                sum += s->rhs[i] * s->rhs[i];
+                components[m] += s->rhs[i];
+            }
         pass->partial[block] = sum;
+        put_residual_sums(pass, block, components);
     }
     return 0;
 }
 
-/* y += alpha p; r_next = r - alpha q; sums r_next . r_next. */
+/* y += alpha p; r_next = r - alpha q; sums r_next . r_next (and its
+ * components). */
 static int update_solution_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
@@ -534,13 +563,17 @@ static int update_solution_range(void *context, int64_t first, int64_t last)
     for (int64_t block = first; block < last; ++block) {
         int64_t begin, end;
         block_bounds(s, block, &begin, &end);
-        double sum = 0.0;
-        for (int64_t i = 3 * begin; i < 3 * end; ++i) {
-            s->y[i] += alpha * s->p[i];
-            pass->r_next[i] = pass->r[i] - alpha * s->q[i];
-            sum += pass->r_next[i] * pass->r_next[i];
-        }
+        double sum = 0.0, components[3] = {0.0, 0.0, 0.0};
+        for (int64_t k = begin; k < end; ++k)
+            for (int m = 0; m < 3; ++m) {
+                int64_t i = 3 * k + m;
+                s->y[i] += alpha * s->p[i];
+                pass->r_next[i] = pass->r[i] - alpha * s->q[i];
+                sum += pass->r_next[i] * pass->r_next[i];
+                components[m] += pass->r_next[i];
+            }
         pass->partial[block] = sum;
+        put_residual_sums(pass, block, components);
     }
     return 0;
 }
@@ -607,6 +640,13 @@ static double precondition(implicit_pass *pass, const wc_team *team, int first,
         wci_team_barrier(team);
         pass->coarse = wci_multigrid_coarse_solution(s->multigrid);
         pass->aggregate = wci_multigrid_fine_aggregates(s->multigrid);
+    } else {
+        /* the residual's sum over the particles, complete after the
+         * barrier; every thread solves for the translation itself */
+        wci_team_barrier(team);
+        double total[3];
+        for (int m = 0; m < 3; ++m) total[m] = set_sum(s, PARTIAL_RX + m);
+        wc_sym3_times(s->translation_inverse, total[0], total[1], total[2], pass->translation);
     }
     team_blocks(pass, team, precondition_range, PARTIAL_RZ);
     if (first) team_blocks(pass, team, first_direction_range, PARTIAL_RZ);
@@ -652,6 +692,7 @@ static void solve_body(void *context, const wc_team *team)
     implicit_pass pass = *shared->pass; /* each thread's own: loops change its fields */
     wc_implicit_state *s = pass.state;
     pass.r = s->r, pass.r_next = s->r_next;
+    pass.residual_sums = s->multigrid ? NULL : s->partial + (size_t)PARTIAL_RX * (size_t)s->blocks;
     team_blocks(&pass, team, start_range, PARTIAL_RR);
     wci_team_barrier(team);
     double bb = set_sum(s, PARTIAL_RR), rr = bb, bound = shared->bound;
@@ -719,6 +760,30 @@ static void solve(implicit_pass *pass, double velocity_tolerance, int threads)
     wci_parallel_team(s->blocks > 1 ? wc_threads_for(s->n, threads) : 1, solve_body, &shared);
 }
 
+/* The matrix restricted to the free particles' common translation, T^T A
+ * T with T the free particles' identity blocks stacked: their mass (with
+ * drag and goal springs), and the blocks of their links to pins, whose
+ * other end does not move with them (links between free particles cancel);
+ * inverted into s->translation_inverse. Without it a cloth's motion as a
+ * whole is what block-Jacobi resolves last, and a solve stopped at its
+ * tolerance keeps part of it unsolved, a stray acceleration of the whole
+ * cloth (docs/model.md). Serial: O(particles + links), once per step. */
+static void translation_matrix(const wc_cloth *c, wc_implicit_state *s)
+{
+    double sum[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    for (int32_t i = 0; i < s->n; ++i) {
+        if (c->pin_slot[i] >= 0) continue;
+        sum[0] += s->mass_diag[i], sum[3] += s->mass_diag[i], sum[5] += s->mass_diag[i];
+        for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
+            int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
+            int32_t j = entry >= 0 ? s->end_b[e] : s->end_a[e];
+            if (c->pin_slot[j] < 0) continue;
+            for (int m = 0; m < 6; ++m) sum[m] += s->block[6 * (size_t)e + m];
+        }
+    }
+    wci_sym3_inverse(sum, s->translation_inverse);
+}
+
 /* First particle whose right-hand side is not finite, -1 if none. Forces
  * that overflowed make it so, and CG would not notice: the norm of such a
  * right-hand side is not > 0, so the solve would return no change and the
@@ -779,8 +844,10 @@ int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doub
      * term of the matrix the same share; with equal steps it is 1, plain
      * backward Euler. */
     double h_prev = c->has_history ? c->dt_prev : 0.0;
-    implicit_pass pass = {c, s, dt, pin_fraction, (dt + h_prev) / (2.0 * dt),
-                          NULL, NULL, 0.0, NULL, NULL, NULL, NULL, NULL};
+    implicit_pass pass;
+    memset(&pass, 0, sizeof pass);
+    pass.cloth = c, pass.state = s, pass.h = dt, pass.pin_fraction = pin_fraction;
+    pass.share = (dt + h_prev) / (2.0 * dt);
     wci_parallel_for(n, particle_threads, start_velocities_range, &pass);
     wci_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
     active_links(&pass, threads);
@@ -789,6 +856,8 @@ int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doub
     if (bad >= 0) return bad;
     if (s->multigrid)
         wci_multigrid_update(s->multigrid, s->mass_diag, s->block, c->pin_slot, threads);
+    else
+        translation_matrix(c, s);
     solve(&pass, tolerance * dt, threads);
     positions_pass positions = {c, s, dt, pin_fraction, pass.share};
     wci_parallel_for(n, particle_threads, positions_range, &positions);

@@ -1,5 +1,6 @@
 #include "multigrid.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -20,6 +21,16 @@
  * Laplacian-like matrix best. */
 #define SMOOTHING_WEIGHT (2.0 / 3.0)
 #define COARSEST_SWEEPS 4
+/* The coarsest level is solved exactly (a dense Cholesky factor, made once
+ * per step) when it has at most this many nodes, as it has on every cloth
+ * whose aggregation does not stall: COARSEST_NODES or fewer. Why: the
+ * coarsest level holds the cloth's motion as a whole, and sweeps leave part
+ * of it unsolved, which a solve stopped at its tolerance then keeps as a
+ * stray acceleration of the whole cloth (a cloth sliding down a slope slid
+ * 2.9 % short at 16 m/s^2 with the sweeps, as far as the closed form with
+ * the exact solve: docs/model.md). 64 nodes are 192 unknowns, a factor of
+ * about 1.2 million multiply-adds a step. */
+#define EXACT_COARSEST_NODES 64
 /* A level's loops (the restriction to it too) split across the solve's
  * threads from this many nodes up, far below WC_PARALLEL_MIN: every CG
  * iteration runs them back to back with the solve's own loops, and left on
@@ -50,6 +61,11 @@ typedef struct level {
 struct wc_multigrid {
     int32_t levels;
     level level[MAX_LEVELS];
+    /* The coarsest level's matrix as a dense lower Cholesky factor, row
+     * major (3 n x 3 n), NULL when that level is too large; `factored`:
+     * whether the step's factor succeeded (it falls back to the sweeps). */
+    double *factor;
+    int factored;
 };
 
 static void level_free(level *l)
@@ -65,6 +81,7 @@ void wci_multigrid_destroy(wc_multigrid *mg)
 {
     if (!mg) return;
     for (int32_t k = 0; k < mg->levels; ++k) level_free(&mg->level[k]);
+    wci_free(mg->factor);
     wci_free(mg);
 }
 
@@ -287,6 +304,13 @@ int wci_multigrid_create(int32_t n, int32_t links, const int32_t *end_a, const i
         /* above the finest level every link joins neighbours */
         neighbour_links = mg->level[mg->levels - 1].links;
     }
+    if (!failed && mg->levels > 1) {
+        int32_t m = 3 * mg->level[mg->levels - 1].n;
+        if (m <= 3 * EXACT_COARSEST_NODES) {
+            mg->factor = wci_alloc_array((size_t)m * (size_t)m, sizeof(double));
+            failed = mg->factor == NULL;
+        }
+    }
     if (failed || mg->levels == 1) {
         wci_multigrid_destroy(mg);
         return failed;
@@ -370,6 +394,82 @@ static int coarse_nodes_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
+/* Adds the symmetric 3 x 3 block b (xx, xy, xz, yy, yz, zz) times sign at
+ * rows 3i.., columns 3j.. of the dense lower triangle a (m columns). */
+static void add_dense_block(double *a, int32_t m, int32_t i, int32_t j, const double *b, double sign)
+{
+    static const int ROW[6] = {0, 0, 0, 1, 1, 2}, COL[6] = {0, 1, 2, 1, 2, 2};
+    for (int k = 0; k < 6; ++k) {
+        int32_t r = 3 * i + ROW[k], c = 3 * j + COL[k];
+        if (r < c) a[(size_t)c * (size_t)m + (size_t)r] += sign * b[k];
+        else a[(size_t)r * (size_t)m + (size_t)c] += sign * b[k];
+        if (ROW[k] == COL[k] || i == j) continue;
+        r = 3 * i + COL[k], c = 3 * j + ROW[k];
+        if (r < c) a[(size_t)c * (size_t)m + (size_t)r] += sign * b[k];
+        else a[(size_t)r * (size_t)m + (size_t)c] += sign * b[k];
+    }
+}
+
+/* The coarsest level's matrix, D_i on the diagonal and each link's B at
+ * (a, a), (b, b) and -B at (a, b), factored in place as L L^T. Returns 0
+ * when a pivot is not positive and finite (the matrix is positive definite
+ * in exact arithmetic: its D holds the aggregates' masses). */
+static int factor_coarsest(wc_multigrid *mg)
+{
+    const level *l = &mg->level[mg->levels - 1];
+    int32_t m = 3 * l->n;
+    double *a = mg->factor;
+    memset(a, 0, (size_t)m * (size_t)m * sizeof *a);
+    for (int32_t i = 0; i < l->n; ++i) add_dense_block(a, m, i, i, l->diag + 6 * (size_t)i, 1.0);
+    for (int32_t e = 0; e < l->links; ++e) {
+        const double *b = l->block + 6 * (size_t)e;
+        int32_t i = l->end_a[e], j = l->end_b[e];
+        add_dense_block(a, m, i, i, b, 1.0);
+        add_dense_block(a, m, j, j, b, 1.0);
+        add_dense_block(a, m, i > j ? i : j, i > j ? j : i, b, -1.0);
+    }
+    /* an aggregate of pinned particles only has an empty row and column
+     * (its restricted residual is zero): 1 on its diagonal keeps its
+     * solution 0 and the factor defined */
+    for (int32_t j = 0; j < m; ++j) {
+        const double *row = a + (size_t)j * (size_t)m;
+        int empty = 1;
+        for (int32_t k = 0; empty && k <= j; ++k) empty = row[k] == 0.0;
+        for (int32_t k = j + 1; empty && k < m; ++k) empty = a[(size_t)k * (size_t)m + (size_t)j] == 0.0;
+        if (empty) a[(size_t)j * (size_t)m + (size_t)j] = 1.0;
+    }
+    for (int32_t j = 0; j < m; ++j) {
+        double *row_j = a + (size_t)j * (size_t)m, pivot = row_j[j];
+        for (int32_t k = 0; k < j; ++k) pivot -= row_j[k] * row_j[k];
+        if (!(pivot > 0.0) || !isfinite(pivot)) return 0;
+        row_j[j] = sqrt(pivot);
+        for (int32_t i = j + 1; i < m; ++i) {
+            double *row_i = a + (size_t)i * (size_t)m, v = row_i[j];
+            for (int32_t k = 0; k < j; ++k) v -= row_i[k] * row_j[k];
+            row_i[j] = v / row_j[j];
+        }
+    }
+    return 1;
+}
+
+/* x = A^-1 b on the coarsest level, by the factor: L y = b, L^T x = y. */
+static void solve_coarsest(const wc_multigrid *mg, level *l)
+{
+    int32_t m = 3 * l->n;
+    const double *a = mg->factor;
+    for (int32_t i = 0; i < m; ++i) {
+        const double *row = a + (size_t)i * (size_t)m;
+        double v = l->b[i];
+        for (int32_t k = 0; k < i; ++k) v -= row[k] * l->x[k];
+        l->x[i] = v / row[i];
+    }
+    for (int32_t i = m - 1; i >= 0; --i) {
+        double v = l->x[i];
+        for (int32_t k = i + 1; k < m; ++k) v -= a[(size_t)k * (size_t)m + (size_t)i] * l->x[k];
+        l->x[i] = v / a[(size_t)i * (size_t)m + (size_t)i];
+    }
+}
+
 void wci_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
                          const int32_t *pin_slot, int threads)
 {
@@ -381,6 +481,7 @@ void wci_multigrid_update(wc_multigrid *mg, const double *mass_diag, const doubl
         wci_parallel_for(links, wc_threads_for(links, threads), coarse_links_range, &p);
         wci_parallel_for(nodes, wc_threads_for(nodes, threads), coarse_nodes_range, &p);
     }
+    mg->factored = mg->factor && factor_coarsest(mg);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -577,6 +678,13 @@ static void cycle(wc_multigrid *mg, int32_t k, const double *in, const double *m
     mg_pass restriction = {f, l, in, l->b, minus, factor};
     int64_t begin, end;
     wc_team_slice(team, l->n, split, &begin, &end);
+    if (k + 1 == mg->levels && mg->factored) {
+        /* at most EXACT_COARSEST_NODES nodes, below LEVEL_PARALLEL_MIN: the
+         * first thread restricts and solves, alone */
+        if (begin < end) restrict_range(&restriction, begin, end);
+        if (begin < end) solve_coarsest(mg, l);
+        return;
+    }
     if (begin < end) restrict_sweep_range(&restriction, begin, end);
     sync_loops(team, split, split);
     if (k + 1 == mg->levels) {

@@ -60,7 +60,7 @@ wc_world_def wc_world_def_default(void)
     d.integrator = WC_INTEGRATOR_IMPLICIT;
     d.substep_safety = 0.9;
     d.max_substeps = 100000;
-    d.implicit_tolerance = 1.0;
+    d.implicit_tolerance = 8.0;
     d.adapt_threads = 1;
     return d;
 }

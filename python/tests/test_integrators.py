@@ -55,7 +55,7 @@ def test_implicit_tolerance_through_the_binding_and_scene_files():
             return w.stats["solver_iterations"]
     exact, default = iterations(implicit_tolerance=0.0), iterations()
     assert exact > default > 0
-    assert wetcloth.World.DEFAULT_IMPLICIT_TOLERANCE == 1.0
+    assert wetcloth.World.DEFAULT_IMPLICIT_TOLERANCE == 8.0
     assert iterations(implicit_tolerance=wetcloth.World.DEFAULT_IMPLICIT_TOLERANCE) == default
     with pytest.raises(wetcloth.WetclothError, match=r"implicit_tolerance must be in \[0, 1000\]"):
         wetcloth.World(integrator="implicit", implicit_tolerance=-1.0)

@@ -213,7 +213,7 @@ class World:
                    [0, 1000]: its linear solve stops at an estimated
                    velocity error of this times the step; 0 solves to
                    round-off. None: the library's default,
-                   World.DEFAULT_IMPLICIT_TOLERANCE (1.0)
+                   World.DEFAULT_IMPLICIT_TOLERANCE (8.0)
 
     Use as a context manager, or call close(), to free the C world at once;
     otherwise it is freed when the World and all its cloths and colliders

@@ -288,7 +288,7 @@ def test_solver_tolerance_reaches_the_world(empty_scene, cache_dir):
     cloth = add_cloth(cache_dir)
     s = cloth.wet_cloth
     s.integrator = "IMPLICIT"
-    assert s.implicit_tolerance == 1.0
+    assert s.implicit_tolerance == 8.0
     # the panel's default is the library's
     from bl_ext.user_default.wetcloth import bake as bake_mod
     assert s.implicit_tolerance == bake_mod.load_wetcloth().World.DEFAULT_IMPLICIT_TOLERANCE
