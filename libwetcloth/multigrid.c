@@ -394,19 +394,21 @@ static int coarse_nodes_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
+/* Entry (r, c) of a symmetric m x m matrix kept as its lower triangle, row
+ * major: (c, r) when r < c. */
+static double *lower(double *a, int32_t m, int32_t r, int32_t c)
+{
+    return r < c ? a + (size_t)c * (size_t)m + (size_t)r : a + (size_t)r * (size_t)m + (size_t)c;
+}
+
 /* Adds the symmetric 3 x 3 block b (xx, xy, xz, yy, yz, zz) times sign at
  * rows 3i.., columns 3j.. of the dense lower triangle a (m columns). */
 static void add_dense_block(double *a, int32_t m, int32_t i, int32_t j, const double *b, double sign)
 {
     static const int ROW[6] = {0, 0, 0, 1, 1, 2}, COL[6] = {0, 1, 2, 1, 2, 2};
     for (int k = 0; k < 6; ++k) {
-        int32_t r = 3 * i + ROW[k], c = 3 * j + COL[k];
-        if (r < c) a[(size_t)c * (size_t)m + (size_t)r] += sign * b[k];
-        else a[(size_t)r * (size_t)m + (size_t)c] += sign * b[k];
-        if (ROW[k] == COL[k] || i == j) continue;
-        r = 3 * i + COL[k], c = 3 * j + ROW[k];
-        if (r < c) a[(size_t)c * (size_t)m + (size_t)r] += sign * b[k];
-        else a[(size_t)r * (size_t)m + (size_t)c] += sign * b[k];
+        *lower(a, m, 3 * i + ROW[k], 3 * j + COL[k]) += sign * b[k];
+        if (ROW[k] != COL[k] && i != j) *lower(a, m, 3 * i + COL[k], 3 * j + ROW[k]) += sign * b[k];
     }
 }
 
@@ -432,11 +434,9 @@ static int factor_coarsest(wc_multigrid *mg)
      * (its restricted residual is zero): 1 on its diagonal keeps its
      * solution 0 and the factor defined */
     for (int32_t j = 0; j < m; ++j) {
-        const double *row = a + (size_t)j * (size_t)m;
         int empty = 1;
-        for (int32_t k = 0; empty && k <= j; ++k) empty = row[k] == 0.0;
-        for (int32_t k = j + 1; empty && k < m; ++k) empty = a[(size_t)k * (size_t)m + (size_t)j] == 0.0;
-        if (empty) a[(size_t)j * (size_t)m + (size_t)j] = 1.0;
+        for (int32_t k = 0; empty && k < m; ++k) empty = *lower(a, m, j, k) == 0.0;
+        if (empty) *lower(a, m, j, j) = 1.0;
     }
     for (int32_t j = 0; j < m; ++j) {
         double *row_j = a + (size_t)j * (size_t)m, pivot = row_j[j];
@@ -456,7 +456,7 @@ static int factor_coarsest(wc_multigrid *mg)
 static void solve_coarsest(const wc_multigrid *mg, level *l)
 {
     int32_t m = 3 * l->n;
-    const double *a = mg->factor;
+    double *a = mg->factor;
     for (int32_t i = 0; i < m; ++i) {
         const double *row = a + (size_t)i * (size_t)m;
         double v = l->b[i];
@@ -465,8 +465,8 @@ static void solve_coarsest(const wc_multigrid *mg, level *l)
     }
     for (int32_t i = m - 1; i >= 0; --i) {
         double v = l->x[i];
-        for (int32_t k = i + 1; k < m; ++k) v -= a[(size_t)k * (size_t)m + (size_t)i] * l->x[k];
-        l->x[i] = v / a[(size_t)i * (size_t)m + (size_t)i];
+        for (int32_t k = i + 1; k < m; ++k) v -= *lower(a, m, k, i) * l->x[k];
+        l->x[i] = v / *lower(a, m, i, i);
     }
 }
 
