@@ -47,9 +47,6 @@ struct wc_implicit_state {
     int32_t n, links, blocks;
     /// Ends of each link, stretch links first, then bend links.
     int32_t *end_a, *end_b;
-    /// Per link: B = share h^2 K + h c u u^T as xx, xy, xz, yy, yz, zz, and
-    /// K (v0_a - v0_b), K = -df_a/dx_a.
-    double *block, *kv;
     /// Per particle: m + h drag A (the diagonal of M - h df/dv from drag),
     /// and the inverse of the whole 3 x 3 diagonal block (6 values).
     double *mass_diag, *precond;
@@ -63,19 +60,20 @@ struct wc_implicit_state {
     /// that a thread that starts the next sum cannot overwrite one that
     /// another thread has not yet added up.
     double *partial;
-    /// The links whose block is not zero in this step (a slack stretch link
-    /// without a dashpot, a bend link that is not compressed: about half of
-    /// a draped cloth's), in index order: `active_count` of them, each with
-    /// a copy of its block and its ends, packed, so that an iteration reads
-    /// them in one sweep of memory instead of picking them out of all the
-    /// links' arrays; per link its place among them (`active_slot`, -1 for
-    /// a zero block); and per particle the entries of its link list
-    /// (cloth.h) that refer to them, in the list's order, at the list's own
-    /// offsets (`row_count` of them), as places (slot k, ~k at its second
-    /// end). The product visits only these: the others would add exact
-    /// zeros.
-    int32_t active_count, *active_slot, *active_a, *active_b, *row_list, *row_count;
-    double *active_block;
+    /// The links with a block in this step (not a slack stretch link
+    /// without a dashpot, not a bend link that is not compressed: those
+    /// would add exact zeros), in index order: `active_count` of them, each
+    /// with its index and ends and, packed, its block B = share h^2 K + h c
+    /// u u^T (xx, xy, xz, yy, yz, zz) and K (v0_a - v0_b), K = -df_a/dx_a,
+    /// so that an iteration reads them in one sweep of memory; per link its
+    /// place among them (`active_slot`, -1 for none); and per particle the
+    /// entries of its link list (cloth.h) that refer to them, in the list's
+    /// order, at the list's own offsets (`row_count` of them), as places
+    /// (slot k, ~k at its second end). A link without a block is never
+    /// written: the product, the right-hand side and the coarse levels
+    /// visit only these.
+    int32_t active_count, *active_slot, *active_link, *active_a, *active_b, *row_list, *row_count;
+    double *active_block, *active_kv;
     /// Per active link, scratch of the product with the matrix:
     /// B (in_a - in_b).
     double *link_product;
@@ -93,13 +91,14 @@ struct wc_implicit_state {
 void wci_implicit_state_destroy(wc_implicit_state *s)
 {
     if (!s) return;
-    double *arrays[] = {s->block, s->kv, s->mass_diag, s->precond, s->v0, s->fixed, s->rhs,
+    double *arrays[] = {s->mass_diag, s->precond, s->v0, s->fixed, s->rhs,
                         s->y, s->r, s->r_next, s->z, s->p, s->q, s->partial,
-                        s->link_product, s->active_block};
+                        s->link_product, s->active_block, s->active_kv};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) wci_free(arrays[i]);
     wci_free(s->end_a);
     wci_free(s->end_b);
     wci_free(s->active_slot);
+    wci_free(s->active_link);
     wci_free(s->active_a);
     wci_free(s->active_b);
     wci_free(s->row_list);
@@ -119,8 +118,6 @@ wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
     s->blocks = (int32_t)((n + BLOCK - 1) / BLOCK);
     s->end_a = wci_alloc_array(links, sizeof *s->end_a);
     s->end_b = wci_alloc_array(links, sizeof *s->end_b);
-    s->block = wci_alloc_array(6 * links, sizeof(double));
-    s->kv = wci_alloc_array(3 * links, sizeof(double));
     s->mass_diag = wci_alloc_array(n, sizeof(double));
     s->precond = wci_alloc_array(6 * n, sizeof(double));
     double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r,
@@ -131,14 +128,16 @@ wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
     s->partial = wci_alloc_array(PARTIAL_SETS * (size_t)s->blocks, sizeof(double));
     s->link_product = wci_alloc_array(3 * links + 1, sizeof(double));
     s->active_slot = wci_alloc_array(links + 1, sizeof *s->active_slot);
+    s->active_link = wci_alloc_array(links + 1, sizeof *s->active_link);
     s->active_a = wci_alloc_array(links + 1, sizeof *s->active_a);
     s->active_b = wci_alloc_array(links + 1, sizeof *s->active_b);
     s->active_block = wci_alloc_array(6 * links + 1, sizeof(double));
+    s->active_kv = wci_alloc_array(3 * links + 1, sizeof(double));
     s->row_list = wci_alloc_array((size_t)c->link_start[n] + 1, sizeof *s->row_list);
     s->row_count = wci_alloc_array(n + 1, sizeof *s->row_count);
-    if (!ok || !s->end_a || !s->end_b || !s->block || !s->kv || !s->mass_diag || !s->precond ||
-        !s->partial || !s->link_product || !s->active_slot ||
-        !s->active_a || !s->active_b || !s->active_block || !s->row_list || !s->row_count) {
+    if (!ok || !s->end_a || !s->end_b || !s->mass_diag || !s->precond || !s->partial ||
+        !s->link_product || !s->active_slot || !s->active_link || !s->active_a || !s->active_b ||
+        !s->active_block || !s->active_kv || !s->row_list || !s->row_count) {
         wci_implicit_state_destroy(s);
         return NULL;
     }
@@ -224,6 +223,69 @@ static void set_block(double *b, double along, double across, double ux, double 
  * passes it is longer than at rest, and not compressed. */
 #define STRETCHED_CLEARLY (1.0 + 1e-9)
 
+/* Whether link e has a block this step, from its squared length d2: a
+ * stretch link that has a dashpot or is taut, a bend link that is
+ * compressed. d2 decides where that is clear whatever the rounding, the
+ * length itself (as the blocks compute it) where it is not. */
+static int link_has_block(const wc_cloth *c, int64_t e, double d2)
+{
+    const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
+    if (e < st->count) {
+        if (!(d2 > 0.0)) return 0;
+        if (c->stretch_c && c->stretch_c[e] != 0.0) return 1;
+        return sqrt(d2) > st->rest[e];
+    }
+    double l = bd->rest[e - st->count];
+    if (d2 > STRETCHED_CLEARLY * l * l) return 0;
+    double d = sqrt(d2);
+    return d > 0.0 && l - d > 0.0;
+}
+
+/* Marks the links [begin, end) that have a block (active_slot 1, else -1);
+ * place_links then numbers them. */
+static int mark_links_range(void *context, int64_t begin, int64_t end)
+{
+    const implicit_pass *pass = context;
+    const wc_cloth *c = pass->cloth;
+    wc_implicit_state *s = pass->state;
+    for (int64_t e = begin; e < end; ++e) {
+        int32_t a = s->end_a[e], b = s->end_b[e];
+        double dx = c->x[a] - c->x[b], dy = c->y[a] - c->y[b], dz = c->z[a] - c->z[b];
+        s->active_slot[e] = link_has_block(c, e, dx * dx + dy * dy + dz * dz) ? 1 : -1;
+    }
+    return 0;
+}
+
+/* The marked links' places, in index order, with their index and ends. */
+static void place_links(wc_implicit_state *s)
+{
+    int32_t count = 0;
+    for (int32_t e = 0; e < s->links; ++e) {
+        if (s->active_slot[e] < 0) continue;
+        s->active_slot[e] = count;
+        s->active_link[count] = e;
+        s->active_a[count] = s->end_a[e], s->active_b[count] = s->end_b[e];
+        ++count;
+    }
+    s->active_count = count;
+}
+
+/* A link's kv = K (v0_a - v0_b), K = along u u^T + across I, and its
+ * block B = (hh along + h damp) u u^T + hh across I. */
+static void put_link(double *blk, double *kv, double along, double across, double damp,
+                     double hh, double h, const double u[3], const double dv[3])
+{
+    double along_dv = along * (u[0] * dv[0] + u[1] * dv[1] + u[2] * dv[2]);
+    kv[0] = along_dv * u[0] + across * dv[0];
+    kv[1] = along_dv * u[1] + across * dv[1];
+    kv[2] = along_dv * u[2] + across * dv[2];
+    set_block(blk, hh * along + h * damp, hh * across, u[0], u[1], u[2]);
+}
+
+/* The blocks of the active links [begin, end) (places): for a stretch
+ * link, one reciprocal of its length gives its direction and l/d; a bend
+ * link whose buckling slope is not positive (the force's polynomial
+ * flattening) gets a zero block, which adds exact zeros. */
 static int link_blocks_range(void *context, int64_t begin, int64_t end)
 {
     const implicit_pass *pass = context;
@@ -231,47 +293,30 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
     wc_implicit_state *s = pass->state;
     double h = pass->h, hh = pass->share * h * h;
     const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
-    int32_t ns = st->count;
     const double *v0 = s->v0;
-    for (int64_t e = begin; e < end; ++e) {
-        int32_t a = s->end_a[e], b = s->end_b[e];
+    for (int64_t k = begin; k < end; ++k) {
+        int32_t e = s->active_link[k], a = s->active_a[k], b = s->active_b[k];
         double dx = c->x[a] - c->x[b], dy = c->y[a] - c->y[b], dz = c->z[a] - c->z[b];
-        double d2 = dx * dx + dy * dy + dz * dz;
-        double *kv = s->kv + 3 * (size_t)e, *blk = s->block + 6 * (size_t)e;
-        if (e >= ns && d2 > STRETCHED_CLEARLY * bd->rest[e - ns] * bd->rest[e - ns]) {
-            /* a bend link that is not compressed has no stiffness: the
-             * block the general path below would make is zero, without
-             * its square root and divisions (most bend links of a draped
-             * cloth) */
-            set_block(blk, 0.0, 0.0, 0.0, 0.0, 0.0);
-            wc_sym3_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
-                          v0[3 * a + 2] - v0[3 * b + 2], kv);
-            continue;
-        }
-        double d = sqrt(d2);
-        double along = 0.0, across = 0.0, damp = 0.0;
-        double ux = 0.0, uy = 0.0, uz = 0.0;
-        if (d > 0.0) ux = dx / d, uy = dy / d, uz = dz / d;
-        if (e < ns) {
-            double l = st->rest[e], k = c->stretch_k[e];
-            if (d > l) along = k * l / d, across = k * (1.0 - l / d);
-            if (c->stretch_c && d > 0.0) damp = c->stretch_c[e];
+        double d = sqrt(dx * dx + dy * dy + dz * dz), inv = 1.0 / d;
+        double u[3] = {dx * inv, dy * inv, dz * inv}, along = 0.0, across = 0.0, damp = 0.0;
+        if (e < st->count) {
+            double l = st->rest[e], k_e = c->stretch_k[e];
+            if (d > l) {
+                double ratio = l * inv;
+                along = k_e * ratio, across = k_e * (1.0 - ratio);
+            }
+            if (c->stretch_c) damp = c->stretch_c[e];
         } else {
-            int32_t f = (int32_t)e - ns;
+            int32_t f = e - st->count;
             along = buckling_slope(d, bd->rest[f], c->bend_r[f]);
-            if (!(d > 0.0)) along = 0.0;
         }
-        set_block(blk, along, across, ux, uy, uz);
-        wc_sym3_times(blk, v0[3 * a] - v0[3 * b], v0[3 * a + 1] - v0[3 * b + 1],
-                    v0[3 * a + 2] - v0[3 * b + 2], kv);
-        set_block(blk, hh * along + h * damp, hh * across, ux, uy, uz);
+        double dv[3] = {v0[3 * (size_t)a] - v0[3 * (size_t)b],
+                        v0[3 * (size_t)a + 1] - v0[3 * (size_t)b + 1],
+                        v0[3 * (size_t)a + 2] - v0[3 * (size_t)b + 2]};
+        put_link(s->active_block + 6 * (size_t)k, s->active_kv + 3 * (size_t)k, along, across,
+                 damp, hh, h, u, dv);
     }
     return 0;
-}
-
-static int block_is_zero(const double *b)
-{
-    return b[0] == 0.0 && b[1] == 0.0 && b[2] == 0.0 && b[3] == 0.0 && b[4] == 0.0 && b[5] == 0.0;
 }
 
 /* Each particle's entries of the links with a block, in its list's order,
@@ -293,24 +338,16 @@ static int rows_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-/* The links the product visits, packed (the state's `active_*`), after the
- * blocks. */
+/* The step's links: which have a block, their places and rows, and their
+ * blocks, written at their places. */
 static void active_links(const implicit_pass *pass, int threads)
 {
     wc_implicit_state *s = pass->state;
-    int32_t count = 0;
-    for (int32_t e = 0; e < s->links; ++e) {
-        const double *blk = s->block + 6 * (size_t)e;
-        if (block_is_zero(blk)) {
-            s->active_slot[e] = -1;
-            continue;
-        }
-        s->active_slot[e] = count;
-        s->active_a[count] = s->end_a[e], s->active_b[count] = s->end_b[e];
-        memcpy(s->active_block + 6 * (size_t)count, blk, 6 * sizeof(double));
-        ++count;
-    }
-    s->active_count = count;
+    wci_parallel_for(s->links, wc_threads_for(s->links, threads), mark_links_range,
+                     (void *)pass);
+    place_links(s);
+    wci_parallel_for(s->active_count, wc_threads_for(s->active_count, threads),
+                     link_blocks_range, (void *)pass);
     wci_parallel_for(s->n, wc_threads_for(s->n, threads), rows_range, (void *)pass);
 }
 
@@ -386,10 +423,12 @@ static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t en
         }
         s->mass_diag[i] = md;
         double diag[6] = {md, 0.0, 0.0, md, 0.0, md};
-        for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
-            int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
-            int32_t j = entry >= 0 ? s->end_b[e] : s->end_a[e];
-            const double *blk = s->block + 6 * (size_t)e, *kv = s->kv + 3 * (size_t)e;
+        const int32_t *row = s->row_list + c->link_start[i];
+        for (int32_t k = 0; k < s->row_count[i]; ++k) {
+            int32_t entry = row[k], slot = entry >= 0 ? entry : ~entry;
+            int32_t j = entry >= 0 ? s->active_b[slot] : s->active_a[slot];
+            const double *blk = s->active_block + 6 * (size_t)slot;
+            const double *kv = s->active_kv + 3 * (size_t)slot;
             for (int m = 0; m < 6; ++m) diag[m] += blk[m];
             double sign = entry >= 0 ? -h2 : h2;
             bx += sign * kv[0], by += sign * kv[1], bz += sign * kv[2];
@@ -774,11 +813,12 @@ static void translation_matrix(const wc_cloth *c, wc_implicit_state *s)
     for (int32_t i = 0; i < s->n; ++i) {
         if (c->pin_slot[i] >= 0) continue;
         sum[0] += s->mass_diag[i], sum[3] += s->mass_diag[i], sum[5] += s->mass_diag[i];
-        for (int32_t k = c->link_start[i]; k < c->link_start[i + 1]; ++k) {
-            int32_t entry = c->link_list[k], e = entry >= 0 ? entry : ~entry;
-            int32_t j = entry >= 0 ? s->end_b[e] : s->end_a[e];
+        const int32_t *row = s->row_list + c->link_start[i];
+        for (int32_t k = 0; k < s->row_count[i]; ++k) {
+            int32_t entry = row[k], slot = entry >= 0 ? entry : ~entry;
+            int32_t j = entry >= 0 ? s->active_b[slot] : s->active_a[slot];
             if (c->pin_slot[j] < 0) continue;
-            for (int m = 0; m < 6; ++m) sum[m] += s->block[6 * (size_t)e + m];
+            for (int m = 0; m < 6; ++m) sum[m] += s->active_block[6 * (size_t)slot + m];
         }
     }
     wci_sym3_inverse(sum, s->translation_inverse);
@@ -849,13 +889,13 @@ int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doub
     pass.cloth = c, pass.state = s, pass.h = dt, pass.pin_fraction = pin_fraction;
     pass.share = (dt + h_prev) / (2.0 * dt);
     wci_parallel_for(n, particle_threads, start_velocities_range, &pass);
-    wci_parallel_for(s->links, wc_threads_for(s->links, threads), link_blocks_range, &pass);
     active_links(&pass, threads);
     wci_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);
     int32_t bad = first_non_finite_rhs(s);
     if (bad >= 0) return bad;
     if (s->multigrid)
-        wci_multigrid_update(s->multigrid, s->mass_diag, s->block, c->pin_slot, threads);
+        wci_multigrid_update(s->multigrid, s->mass_diag, s->active_block, s->active_slot,
+                             c->pins.count > c->pins.soft_count ? c->pin_slot : NULL, threads);
     else
         translation_matrix(c, s);
     solve(&pass, tolerance * dt, threads);

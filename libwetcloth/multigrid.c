@@ -47,7 +47,7 @@ typedef struct level {
      * blocks and the pins, all borrowed; above, D, B and the inverse of
      * D_full, 6 numbers per node or link */
     const double *mass, *block;
-    const int32_t *pin_slot;
+    const int32_t *block_slot, *pin_slot;
     double *diag, *own_block, *inv;
     /* toward the next coarser level: each node's aggregate, each
      * aggregate's nodes (CSR), each coarse link's fine links (CSR) */
@@ -341,6 +341,15 @@ static void add_block(double *to, const double *b)
     for (int k = 0; k < 6; ++k) to[k] += b[k];
 }
 
+/* Link e's block, NULL when it has none this step (block_slot, at the
+ * finest level: wci_multigrid_update). */
+static const double *link_block(const level *l, int32_t e)
+{
+    if (!l->block_slot) return l->block + 6 * (size_t)e;
+    int32_t slot = l->block_slot[e];
+    return slot >= 0 ? l->block + 6 * (size_t)slot : NULL;
+}
+
 /* A coarse link's block: the sum of its fine links' blocks, those between
  * free particles (a link to a pin acts on its free end's diagonal). */
 static int coarse_links_range(void *context, int64_t begin, int64_t end)
@@ -353,8 +362,9 @@ static int coarse_links_range(void *context, int64_t begin, int64_t end)
         for (int k = 0; k < 6; ++k) b[k] = 0.0;
         for (int32_t k = f->fine_start[e]; k < f->fine_start[e + 1]; ++k) {
             int32_t fe = f->fine_links[k];
-            if (pinned(f, f->end_a[fe]) || pinned(f, f->end_b[fe])) continue;
-            add_block(b, f->block + 6 * (size_t)fe);
+            const double *fine = link_block(f, fe);
+            if (!fine || pinned(f, f->end_a[fe]) || pinned(f, f->end_b[fe])) continue;
+            add_block(b, fine);
         }
     }
     return 0;
@@ -370,9 +380,10 @@ static void add_member_diag(const level *f, int32_t i, double *d)
     }
     d[0] += f->mass[i], d[3] += f->mass[i], d[5] += f->mass[i];
     if (!f->pin_slot) return;
-    for (int32_t k = f->adj_start[i]; k < f->adj_start[i + 1]; ++k)
-        if (pinned(f, other_end(f, f->adj[k])))
-            add_block(d, f->block + 6 * (size_t)link_of(f->adj[k]));
+    for (int32_t k = f->adj_start[i]; k < f->adj_start[i + 1]; ++k) {
+        const double *b = link_block(f, link_of(f->adj[k]));
+        if (b && pinned(f, other_end(f, f->adj[k]))) add_block(d, b);
+    }
 }
 
 /* An aggregate's D, and the inverse of its D_full for the smoother. */
@@ -471,10 +482,11 @@ static void solve_coarsest(const wc_multigrid *mg, level *l)
 }
 
 void wci_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
-                         const int32_t *pin_slot, int threads)
+                         const int32_t *block_slot, const int32_t *pin_slot, int threads)
 {
     level *fine = &mg->level[0];
-    fine->mass = mass_diag, fine->block = block, fine->pin_slot = pin_slot;
+    fine->mass = mass_diag, fine->block = block, fine->block_slot = block_slot;
+    fine->pin_slot = pin_slot;
     for (int32_t k = 0; k + 1 < mg->levels; ++k) {
         mg_pass p = {&mg->level[k], &mg->level[k + 1], NULL, NULL, NULL, 0.0};
         int32_t links = p.coarse->links, nodes = p.coarse->n;

@@ -63,11 +63,14 @@ void wci_multigrid_destroy(wc_multigrid *mg);
 int32_t wci_multigrid_levels(const wc_multigrid *mg);
 
 /// The step's matrix: per particle the mass with drag (`mass_diag`, a
-/// multiple of the identity), per link its block (6 values: xx, xy, xz, yy,
-/// yz, zz), and the pins (`pin_slot` >= 0: pinned; their rows and columns
-/// are removed). The arrays are borrowed until the next update.
+/// multiple of the identity), the link blocks (6 values: xx, xy, xz, yy,
+/// yz, zz), link e's at `block_slot[e]` (-1: e has none this step), or at e
+/// when `block_slot` is NULL, and the pins (`pin_slot` >= 0: pinned; their
+/// rows and columns are removed; NULL when nothing is pinned, which spares
+/// the levels' updates and restrictions their checks). The arrays are
+/// borrowed until the next update.
 void wci_multigrid_update(wc_multigrid *mg, const double *mass_diag, const double *block,
-                         const int32_t *pin_slot, int threads);
+                         const int32_t *block_slot, const int32_t *pin_slot, int threads);
 
 /// z += P C P^T r, the coarse levels' part of the preconditioner; r is
 /// zero at pins and z is left unchanged there.

@@ -192,7 +192,7 @@ static wc_multigrid *build(const graph *g, int threads)
     int failed = wci_multigrid_create(g->n, g->links, g->end_a, g->end_b, g->stretch, g->adj_start,
                                      g->adj, &mg);
     CHECK(!failed && mg != NULL, "create: failed %d", failed);
-    if (mg) wci_multigrid_update(mg, g->mass, g->block, g->pin_slot, threads);
+    if (mg) wci_multigrid_update(mg, g->mass, g->block, NULL, g->pin_slot, threads);
     return mg;
 }
 
