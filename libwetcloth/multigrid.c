@@ -53,9 +53,11 @@ typedef struct level {
      * aggregate's nodes (CSR), each coarse link's fine links (CSR) */
     int32_t *agg, *member_start, *members, *fine_start, *fine_links;
     /* cycle vectors, 3 per node (coarse levels): solution, right-hand
-     * side, residual, and the solution after the last sweep of a level
-     * above the coarsest (cycle_solution) */
-    double *x, *b, *r, *post;
+     * side, residual, the solution after the last sweep of a level above
+     * the coarsest (cycle_solution), and the solution with the coarser
+     * level's correction (correct_smooth); 3 per link: the product's
+     * B (x_a - x_b) */
+    double *x, *b, *r, *post, *corrected, *link_product;
 } level;
 
 struct wc_multigrid {
@@ -73,7 +75,8 @@ static void level_free(level *l)
     for (int k = 0; k < 4; ++k) wci_free(l->own_ints[k]);
     int32_t *ints[] = {l->agg, l->member_start, l->members, l->fine_start, l->fine_links};
     for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) wci_free(ints[k]);
-    double *doubles[] = {l->diag, l->own_block, l->inv, l->x, l->b, l->r, l->post};
+    double *doubles[] = {l->diag, l->own_block, l->inv, l->x, l->b, l->r, l->post,
+                         l->corrected, l->link_product};
     for (size_t k = 0; k < sizeof doubles / sizeof doubles[0]; ++k) wci_free(doubles[k]);
 }
 
@@ -261,7 +264,10 @@ static int allocate_values(level *c)
     c->b = wci_alloc_array(3 * n, sizeof(double));
     c->r = wci_alloc_array(3 * n, sizeof(double));
     c->post = wci_alloc_array(3 * n, sizeof(double));
-    return !c->diag || !c->inv || !c->own_block || !c->x || !c->b || !c->r || !c->post;
+    c->corrected = wci_alloc_array(3 * n, sizeof(double));
+    c->link_product = wci_alloc_array(3 * (size_t)c->links + 1, sizeof(double));
+    return !c->diag || !c->inv || !c->own_block || !c->x || !c->b || !c->r || !c->post ||
+           !c->corrected || !c->link_product;
 }
 
 /* Adds the level above the top one, unless the top one is small enough or
@@ -500,21 +506,49 @@ void wci_multigrid_update(wc_multigrid *mg, const double *mass_diag, const doubl
 /* The correction                                                           */
 /* ------------------------------------------------------------------------ */
 
-/* r = b - A x on a coarse level. */
+/* A coarse level's product with x = p->in, first pass: per link B (x_a -
+ * x_b), each block applied once (half the arithmetic of applying it from
+ * both ends' rows). */
+static int link_products_range(void *context, int64_t begin, int64_t end)
+{
+    const mg_pass *p = context;
+    level *l = p->fine;
+    for (int64_t e = begin; e < end; ++e) {
+        const double *xa = p->in + 3 * (size_t)l->end_a[e], *xb = p->in + 3 * (size_t)l->end_b[e];
+        wc_sym3_times(l->block + 6 * (size_t)e, xa[0] - xb[0], xa[1] - xb[1], xa[2] - xb[2],
+                      l->link_product + 3 * (size_t)e);
+    }
+    return 0;
+}
+
+/* Its second pass at node i: (A x)_i = D x_i + the node's links' products,
+ * added at their first end and subtracted at their second (B (x_b - x_a)
+ * is exactly -B (x_a - x_b)): the bits of applying each block from the
+ * node's row, in the adjacency's order. */
+static void product_row(const level *l, const double *x, int32_t i, double ax[3])
+{
+    const double *xi = x + 3 * (size_t)i;
+    wc_sym3_times(l->diag + 6 * (size_t)i, xi[0], xi[1], xi[2], ax);
+    for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k) {
+        int32_t entry = l->adj[k];
+        const double *t = l->link_product + 3 * (size_t)link_of(entry);
+        if (entry >= 0) {
+            ax[0] += t[0], ax[1] += t[1], ax[2] += t[2];
+        } else {
+            ax[0] -= t[0], ax[1] -= t[1], ax[2] -= t[2];
+        }
+    }
+}
+
+/* r = b - A x on a coarse level, after link_products_range on x. */
 static int residual_range(void *context, int64_t begin, int64_t end)
 {
     const mg_pass *p = context;
     level *l = p->fine;
     for (int64_t i = begin; i < end; ++i) {
-        const double *xi = l->x + 3 * (size_t)i, *b = l->b + 3 * (size_t)i;
-        double t[3], ax[3];
-        wc_sym3_times(l->diag + 6 * (size_t)i, xi[0], xi[1], xi[2], ax);
-        for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k) {
-            const double *xj = l->x + 3 * (size_t)other_end(l, l->adj[k]);
-            wc_sym3_times(l->block + 6 * (size_t)link_of(l->adj[k]), xi[0] - xj[0], xi[1] - xj[1],
-                          xi[2] - xj[2], t);
-            ax[0] += t[0], ax[1] += t[1], ax[2] += t[2];
-        }
+        double ax[3];
+        product_row(l, l->x, (int32_t)i, ax);
+        const double *b = l->b + 3 * (size_t)i;
         double *r = l->r + 3 * (size_t)i;
         r[0] = b[0] - ax[0], r[1] = b[1] - ax[1], r[2] = b[2] - ax[2];
     }
@@ -581,38 +615,35 @@ static int prolong_range(void *context, int64_t begin, int64_t end)
     return 0;
 }
 
-/* Node i's x after the coarse correction, x_i + (P in)_i, as prolong_range
- * adds it. */
-static void corrected(const level *l, const double *in, int32_t i, double *out)
+/* x' = x + P in, the coarse correction taken at each node as
+ * prolong_range adds it, into l->corrected. */
+static int corrected_range(void *context, int64_t begin, int64_t end)
 {
-    const double *x = l->x + 3 * (size_t)i;
-    out[0] = x[0], out[1] = x[1], out[2] = x[2];
-    if (pinned(l, i)) return;
-    const double *xc = in + 3 * (size_t)l->agg[i];
-    out[0] += xc[0], out[1] += xc[1], out[2] += xc[2];
+    const mg_pass *p = context;
+    level *l = p->fine;
+    for (int64_t i = begin; i < end; ++i) {
+        const double *x = l->x + 3 * (size_t)i;
+        double *out = l->corrected + 3 * (size_t)i;
+        out[0] = x[0], out[1] = x[1], out[2] = x[2];
+        if (pinned(l, (int32_t)i)) continue;
+        const double *xc = p->in + 3 * (size_t)l->agg[i];
+        out[0] += xc[0], out[1] += xc[1], out[2] += xc[2];
+    }
+    return 0;
 }
 
-/* The coarse correction and the sweep after it in one loop, the
- * correction taken at each node where it is read: post = x' + w D_full^-1
- * (b - A x'), x' = x + P in. The same arithmetic as prolong_range,
- * residual_range and sweep_range one after the other, without the two
- * barriers between them: x' is never stored, and the sweep writes post,
- * not the x that other nodes' rows read. */
+/* The sweep after the coarse correction, post = x' + w D_full^-1 (b - A
+ * x'), after link_products_range on x' (l->corrected): the same arithmetic
+ * as prolong_range, residual_range and sweep_range one after the other,
+ * with the sweep writing post, not the x that other nodes' rows read. */
 static int correct_smooth_range(void *context, int64_t begin, int64_t end)
 {
     const mg_pass *p = context;
     level *l = p->fine;
     for (int64_t i = begin; i < end; ++i) {
-        double xi[3], xj[3], t[3], ax[3], r[3];
-        corrected(l, p->in, (int32_t)i, xi);
-        wc_sym3_times(l->diag + 6 * (size_t)i, xi[0], xi[1], xi[2], ax);
-        for (int32_t k = l->adj_start[i]; k < l->adj_start[i + 1]; ++k) {
-            corrected(l, p->in, other_end(l, l->adj[k]), xj);
-            wc_sym3_times(l->block + 6 * (size_t)link_of(l->adj[k]), xi[0] - xj[0], xi[1] - xj[1],
-                          xi[2] - xj[2], t);
-            ax[0] += t[0], ax[1] += t[1], ax[2] += t[2];
-        }
-        const double *b = l->b + 3 * (size_t)i;
+        double ax[3], r[3], t[3];
+        product_row(l, l->corrected, (int32_t)i, ax);
+        const double *b = l->b + 3 * (size_t)i, *xi = l->corrected + 3 * (size_t)i;
         r[0] = b[0] - ax[0], r[1] = b[1] - ax[1], r[2] = b[2] - ax[2];
         wc_sym3_times(l->inv + 6 * (size_t)i, r[0], r[1], r[2], t);
         double *x = p->out + 3 * (size_t)i;
@@ -667,11 +698,19 @@ static void sync_loops(const wc_team *team, int split_before, int split_after)
     if (split_before || split_after) wci_team_barrier(team);
 }
 
+/* r = b - A x on level l: the product's two passes, the second making r. */
+static void residual(level *l, int split, const wc_team *team)
+{
+    team_loop(team, split, link_products_range, l, NULL, l->x, NULL, l->links);
+    sync_loops(team, split, split);
+    team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
+}
+
 /* One smoothing sweep after the first: the residual, then the sweep from
  * it. The sweep writes x, which the other nodes' residuals read. */
 static void smooth(level *l, int split, const wc_team *team)
 {
-    team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
+    residual(l, split, team);
     sync_loops(team, split, split);
     team_loop(team, split, sweep_range, l, NULL, l->r, NULL, l->n);
 }
@@ -708,11 +747,15 @@ static void cycle(wc_multigrid *mg, int32_t k, const double *in, const double *m
     }
     level *c = &mg->level[k + 1];
     int split_c = level_split(team, c);
-    team_loop(team, split, residual_range, l, NULL, NULL, NULL, l->n);
+    residual(l, split, team);
     sync_loops(team, split, split_c);
     cycle(mg, k + 1, l->r, NULL, 0.0, team);
     sync_loops(team, split_c, split);
-    team_loop(team, split, correct_smooth_range, l, c, cycle_solution(mg, k + 1), l->post, l->n);
+    team_loop(team, split, corrected_range, l, c, cycle_solution(mg, k + 1), NULL, l->n);
+    sync_loops(team, split, split);
+    team_loop(team, split, link_products_range, l, NULL, l->corrected, NULL, l->links);
+    sync_loops(team, split, split);
+    team_loop(team, split, correct_smooth_range, l, c, NULL, l->post, l->n);
 }
 
 void wci_multigrid_coarse_solve_team(wc_multigrid *mg, const double *r, const double *q,
@@ -767,7 +810,8 @@ void wci_multigrid_level_product(wc_multigrid *mg, int32_t k, const double *in, 
     size_t len = 3 * (size_t)l->n;
     memcpy(l->x, in, len * sizeof *in);
     memset(l->b, 0, len * sizeof *l->b);
-    mg_pass p = {l, NULL, NULL, NULL, NULL, 0.0};
+    mg_pass p = {l, NULL, l->x, NULL, NULL, 0.0};
+    link_products_range(&p, 0, l->links);
     residual_range(&p, 0, l->n);
     for (size_t k = 0; k < len; ++k) out[k] = -l->r[k];
 }
