@@ -277,14 +277,27 @@ static void place_links(wc_implicit_state *s)
     s->active_count = count;
 }
 
+/* Links per batch of link_blocks_range: its loops are split so that each
+ * has a short body, and the square roots and divisions of a batch's links
+ * overlap instead of each link waiting on its own (the forces' bend loop
+ * does the same, forces.c). */
+#define LINK_BATCH 64
+
+/* A batch's lengths and their reciprocals, and per link its stiffness along
+ * u, across and its dashpot. */
+typedef struct link_batch {
+    double d[LINK_BATCH], inv[LINK_BATCH], along[LINK_BATCH], across[LINK_BATCH];
+    double damp[LINK_BATCH], root[LINK_BATCH];
+} link_batch;
+
 /* Active link k's kv = K (v0_a - v0_b), K = along u u^T + across I, and
  * its block B = (hh along + h damp) u u^T + hh across I, as six values and
- * as w and beta (active_wb). along, across, damp >= 0. */
+ * as w and beta (active_wb; root = sqrt(hh along + h damp)). */
 static void put_link(wc_implicit_state *s, int64_t k, double along, double across, double damp,
-                     double hh, double h, const double u[3], const double dv[3])
+                     double root, double hh, double h, const double u[3], const double dv[3])
 {
     double *blk = s->active_block + 6 * (size_t)k, *kv = s->active_kv + 3 * (size_t)k;
-    double *wb = s->active_wb + 4 * (size_t)k, root = sqrt(hh * along + h * damp);
+    double *wb = s->active_wb + 4 * (size_t)k;
     wb[0] = root * u[0], wb[1] = root * u[1], wb[2] = root * u[2], wb[3] = hh * across;
     double along_dv = along * (u[0] * dv[0] + u[1] * dv[1] + u[2] * dv[2]);
     kv[0] = along_dv * u[0] + across * dv[0];
@@ -293,27 +306,34 @@ static void put_link(wc_implicit_state *s, int64_t k, double along, double acros
     set_block(blk, hh * along + h * damp, hh * across, u[0], u[1], u[2]);
 }
 
-/* The blocks of the active links [begin, end) (places): for a stretch
- * link, one reciprocal of its length gives its direction and l/d; a bend
- * link whose buckling slope is not positive (the force's polynomial
- * flattening) gets a zero block, which adds exact zeros. */
-static int link_blocks_range(void *context, int64_t begin, int64_t end)
+static void link_vector(const wc_cloth *c, const wc_implicit_state *s, int64_t k, double v[3])
 {
-    const implicit_pass *pass = context;
+    int32_t a = s->active_a[k], b = s->active_b[k];
+    v[0] = c->x[a] - c->x[b], v[1] = c->y[a] - c->y[b], v[2] = c->z[a] - c->z[b];
+}
+
+/* The stiffness of active links [first, first + count) into the batch: for
+ * a stretch link, l/d from the reciprocal of its length; a bend link whose
+ * buckling slope is not positive (the force's polynomial flattening) gets
+ * a zero block, which adds exact zeros. */
+static void batch_stiffness(const implicit_pass *pass, int64_t first, int count, link_batch *t)
+{
     const wc_cloth *c = pass->cloth;
-    wc_implicit_state *s = pass->state;
-    double h = pass->h, hh = pass->share * h * h;
+    const wc_implicit_state *s = pass->state;
     const wc_link_set *st = &c->topology.stretch, *bd = &c->topology.bend;
-    const double *v0 = s->v0;
-    for (int64_t k = begin; k < end; ++k) {
-        int32_t e = s->active_link[k], a = s->active_a[k], b = s->active_b[k];
-        double dx = c->x[a] - c->x[b], dy = c->y[a] - c->y[b], dz = c->z[a] - c->z[b];
-        double d = sqrt(dx * dx + dy * dy + dz * dz), inv = 1.0 / d;
-        double u[3] = {dx * inv, dy * inv, dz * inv}, along = 0.0, across = 0.0, damp = 0.0;
+    for (int j = 0; j < count; ++j) {
+        double v[3];
+        link_vector(c, s, first + j, v);
+        t->d[j] = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    }
+    for (int j = 0; j < count; ++j) t->inv[j] = 1.0 / t->d[j];
+    for (int j = 0; j < count; ++j) {
+        int32_t e = s->active_link[first + j];
+        double d = t->d[j], along = 0.0, across = 0.0, damp = 0.0;
         if (e < st->count) {
             double l = st->rest[e], k_e = c->stretch_k[e];
             if (d > l) {
-                double ratio = l * inv;
+                double ratio = l * t->inv[j];
                 along = k_e * ratio, across = k_e * (1.0 - ratio);
             }
             if (c->stretch_c) damp = c->stretch_c[e];
@@ -321,10 +341,34 @@ static int link_blocks_range(void *context, int64_t begin, int64_t end)
             int32_t f = e - st->count;
             along = buckling_slope(d, bd->rest[f], c->bend_r[f]);
         }
-        double dv[3] = {v0[3 * (size_t)a] - v0[3 * (size_t)b],
-                        v0[3 * (size_t)a + 1] - v0[3 * (size_t)b + 1],
-                        v0[3 * (size_t)a + 2] - v0[3 * (size_t)b + 2]};
-        put_link(s, k, along, across, damp, hh, h, u, dv);
+        t->along[j] = along, t->across[j] = across, t->damp[j] = damp;
+    }
+}
+
+/* The blocks of the active links [begin, end) (places), a batch at a time. */
+static int link_blocks_range(void *context, int64_t begin, int64_t end)
+{
+    const implicit_pass *pass = context;
+    const wc_cloth *c = pass->cloth;
+    wc_implicit_state *s = pass->state;
+    double h = pass->h, hh = pass->share * h * h;
+    const double *v0 = s->v0;
+    link_batch t;
+    for (int64_t first = begin; first < end; first += LINK_BATCH) {
+        int count = end - first < LINK_BATCH ? (int)(end - first) : LINK_BATCH;
+        batch_stiffness(pass, first, count, &t);
+        for (int j = 0; j < count; ++j) t.root[j] = sqrt(hh * t.along[j] + h * t.damp[j]);
+        for (int j = 0; j < count; ++j) {
+            int64_t k = first + j;
+            int32_t a = s->active_a[k], b = s->active_b[k];
+            double v[3];
+            link_vector(c, s, k, v);
+            double u[3] = {v[0] * t.inv[j], v[1] * t.inv[j], v[2] * t.inv[j]};
+            double dv[3] = {v0[3 * (size_t)a] - v0[3 * (size_t)b],
+                            v0[3 * (size_t)a + 1] - v0[3 * (size_t)b + 1],
+                            v0[3 * (size_t)a + 2] - v0[3 * (size_t)b + 2]};
+            put_link(s, k, t.along[j], t.across[j], t.damp[j], t.root[j], hh, h, u, dv);
+        }
     }
     return 0;
 }
