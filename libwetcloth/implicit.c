@@ -34,6 +34,10 @@
 /* Dot products sum fixed blocks of this many particles, then the blocks in
  * order: the same rounding for any thread count. */
 #define BLOCK 512
+/* The links are marked and placed in chunks of this many (owner_order):
+ * each chunk's count, then its places from their running sum, so that both
+ * loops split across threads and the places are the same for any count. */
+#define PLACE_CHUNK 2048
 /* The sets of partial sums: r . r (and b . b), p . A p, r . z, and the
  * residual's x, y and z summed over the particles (the translation's share
  * of it, for a cloth without coarse levels). */
@@ -56,6 +60,9 @@ struct wc_implicit_state {
     /// 156-159 ms per frame on the 10,201-particle drape against 142-146
     /// in this order; 1 thread the same).
     int32_t *owner_order;
+    /// Per PLACE_CHUNK links of owner_order: how many have a block this
+    /// step, then where the chunk's places start.
+    int32_t chunks, *chunk_start;
     /// Per particle: m + h drag A (the diagonal of M - h df/dv from drag),
     /// and the inverse of the whole 3 x 3 diagonal block (6 values).
     double *mass_diag, *precond;
@@ -132,6 +139,7 @@ void wci_implicit_state_destroy(wc_implicit_state *s)
     wci_free(s->end_a);
     wci_free(s->end_b);
     wci_free(s->owner_order);
+    wci_free(s->chunk_start);
     wci_free(s->active_slot);
     wci_free(s->active_link);
     wci_free(s->active_a);
@@ -154,6 +162,8 @@ wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
     s->end_a = wci_alloc_array(links, sizeof *s->end_a);
     s->end_b = wci_alloc_array(links, sizeof *s->end_b);
     s->owner_order = wci_alloc_array(links + 1, sizeof *s->owner_order);
+    s->chunks = (int32_t)((links + PLACE_CHUNK - 1) / PLACE_CHUNK);
+    s->chunk_start = wci_alloc_array((size_t)s->chunks + 1, sizeof *s->chunk_start);
     s->mass_diag = wci_alloc_array(n, sizeof(double));
     s->precond = wci_alloc_array(6 * n, sizeof(double));
     double **vectors[] = {&s->v0, &s->fixed, &s->rhs, &s->y, &s->r,
@@ -172,7 +182,7 @@ wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
     s->active_wb = wci_alloc_array(4 * links + 1, sizeof(double));
     s->row_list = wci_alloc_array((size_t)c->link_start[n] + 1, sizeof *s->row_list);
     s->row_count = wci_alloc_array(n + 1, sizeof *s->row_count);
-    if (!ok || !s->end_a || !s->end_b || !s->owner_order || !s->mass_diag || !s->precond || !s->partial ||
+    if (!ok || !s->end_a || !s->end_b || !s->owner_order || !s->chunk_start || !s->mass_diag || !s->precond || !s->partial ||
         !s->link_product || !s->active_slot || !s->active_link || !s->active_a || !s->active_b ||
         !s->active_block || !s->active_kv || !s->active_wb || !s->row_list || !s->row_count) {
         wci_implicit_state_destroy(s);
@@ -282,35 +292,54 @@ static int link_has_block(const wc_cloth *c, int64_t e, double d2)
     return d > 0.0 && l - d > 0.0;
 }
 
-/* Marks the links [begin, end) that have a block (active_slot 1, else -1);
- * place_links then numbers them. */
-static int mark_links_range(void *context, int64_t begin, int64_t end)
+static void chunk_bounds(const wc_implicit_state *s, int64_t chunk, int64_t *begin, int64_t *end)
+{
+    *begin = chunk * PLACE_CHUNK;
+    *end = *begin + PLACE_CHUNK < s->links ? *begin + PLACE_CHUNK : s->links;
+}
+
+/* Marks the links of chunks [first, last) of owner_order that have a block
+ * (active_slot 1, else -1) and counts them per chunk. */
+static int mark_links_range(void *context, int64_t first, int64_t last)
 {
     const implicit_pass *pass = context;
     const wc_cloth *c = pass->cloth;
     wc_implicit_state *s = pass->state;
-    for (int64_t e = begin; e < end; ++e) {
-        int32_t a = s->end_a[e], b = s->end_b[e];
-        double dx = c->x[a] - c->x[b], dy = c->y[a] - c->y[b], dz = c->z[a] - c->z[b];
-        s->active_slot[e] = link_has_block(c, e, dx * dx + dy * dy + dz * dz) ? 1 : -1;
+    for (int64_t chunk = first; chunk < last; ++chunk) {
+        int64_t begin, end;
+        chunk_bounds(s, chunk, &begin, &end);
+        int32_t count = 0;
+        for (int64_t k = begin; k < end; ++k) {
+            int32_t e = s->owner_order[k], a = s->end_a[e], b = s->end_b[e];
+            double dx = c->x[a] - c->x[b], dy = c->y[a] - c->y[b], dz = c->z[a] - c->z[b];
+            int on = link_has_block(c, e, dx * dx + dy * dy + dz * dz);
+            s->active_slot[e] = on ? 1 : -1;
+            count += on;
+        }
+        s->chunk_start[chunk + 1] = count;
     }
     return 0;
 }
 
-/* The marked links' places, in the owners' order (the state's
- * owner_order), with their index and ends. */
-static void place_links(wc_implicit_state *s)
+/* The marked links' places, in owner_order, with their index and ends,
+ * for chunks [first, last) (chunk_start made). */
+static int place_links_range(void *context, int64_t first, int64_t last)
 {
-    int32_t count = 0;
-    for (int32_t k = 0; k < s->links; ++k) {
-        int32_t e = s->owner_order[k];
-        if (s->active_slot[e] < 0) continue;
-        s->active_slot[e] = count;
-        s->active_link[count] = e;
-        s->active_a[count] = s->end_a[e], s->active_b[count] = s->end_b[e];
-        ++count;
+    wc_implicit_state *s = ((const implicit_pass *)context)->state;
+    for (int64_t chunk = first; chunk < last; ++chunk) {
+        int64_t begin, end;
+        chunk_bounds(s, chunk, &begin, &end);
+        int32_t slot = s->chunk_start[chunk];
+        for (int64_t k = begin; k < end; ++k) {
+            int32_t e = s->owner_order[k];
+            if (s->active_slot[e] < 0) continue;
+            s->active_slot[e] = slot;
+            s->active_link[slot] = e;
+            s->active_a[slot] = s->end_a[e], s->active_b[slot] = s->end_b[e];
+            ++slot;
+        }
     }
-    s->active_count = count;
+    return 0;
 }
 
 /* Links per batch of link_blocks_range: its loops are split so that each
@@ -433,9 +462,12 @@ static int rows_range(void *context, int64_t begin, int64_t end)
 static void active_links(const implicit_pass *pass, int threads)
 {
     wc_implicit_state *s = pass->state;
-    wci_parallel_for(s->links, wc_threads_for(s->links, threads), mark_links_range,
-                     (void *)pass);
-    place_links(s);
+    int chunk_threads = wc_threads_for(s->links, threads);
+    wci_parallel_for(s->chunks, chunk_threads, mark_links_range, (void *)pass);
+    s->chunk_start[0] = 0;
+    for (int32_t k = 0; k < s->chunks; ++k) s->chunk_start[k + 1] += s->chunk_start[k];
+    s->active_count = s->chunk_start[s->chunks];
+    wci_parallel_for(s->chunks, chunk_threads, place_links_range, (void *)pass);
     wci_parallel_for(s->active_count, wc_threads_for(s->active_count, threads),
                      link_blocks_range, (void *)pass);
     wci_parallel_for(s->n, wc_threads_for(s->n, threads), rows_range, (void *)pass);
