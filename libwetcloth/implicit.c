@@ -182,9 +182,10 @@ wc_implicit_state *wci_implicit_state_create(const wc_cloth *c)
     s->active_wb = wci_alloc_array(4 * links + 1, sizeof(double));
     s->row_list = wci_alloc_array((size_t)c->link_start[n] + 1, sizeof *s->row_list);
     s->row_count = wci_alloc_array(n + 1, sizeof *s->row_count);
-    if (!ok || !s->end_a || !s->end_b || !s->owner_order || !s->chunk_start || !s->mass_diag || !s->precond || !s->partial ||
-        !s->link_product || !s->active_slot || !s->active_link || !s->active_a || !s->active_b ||
-        !s->active_block || !s->active_kv || !s->active_wb || !s->row_list || !s->row_count) {
+    if (!ok || !s->end_a || !s->end_b || !s->owner_order || !s->chunk_start || !s->mass_diag ||
+        !s->precond || !s->partial || !s->link_product || !s->active_slot || !s->active_link ||
+        !s->active_a || !s->active_b || !s->active_block || !s->active_kv || !s->active_wb ||
+        !s->row_list || !s->row_count) {
         wci_implicit_state_destroy(s);
         return NULL;
     }
@@ -371,6 +372,7 @@ static void put_link(wc_implicit_state *s, int64_t k, double along, double acros
     set_block(blk, hh * along + h * damp, hh * across, u[0], u[1], u[2]);
 }
 
+/* Active link k's vector x_a - x_b. */
 static void link_vector(const wc_cloth *c, const wc_implicit_state *s, int64_t k, double v[3])
 {
     int32_t a = s->active_a[k], b = s->active_b[k];
