@@ -250,6 +250,9 @@ typedef struct wc_list_maker {
  * hold a batch's pairs, not those of every list at once (the first making
  * on a dense collider lists millions of pairs). */
 #define LISTS_BATCH 4096
+/* Jobs a thread claims at a time: enough that threads seldom write the
+ * same cache line of the jobs. */
+#define LISTS_CLAIM 64
 
 static void makers_free(wc_candidates *c)
 {
@@ -476,24 +479,45 @@ typedef struct make_pass {
     const wc_collider *col;
     /* the batch: jobs [first, first + count) */
     int32_t first, count;
+    /* the batch's first job that no thread has claimed yet */
+    int32_t next;
 } make_pass;
 
+/* Each thread claims LISTS_CLAIM jobs at a time until the batch is done:
+ * the jobs come kind by kind (particles, triangles, edges) and the kinds
+ * cost differently, so equal slices would leave a thread waiting. Which
+ * thread makes a list changes nothing but where its pairs wait (job->maker):
+ * put_list puts them in job order. */
 static void make_body(void *context, const wc_team *team)
 {
-    const make_pass *pass = context;
+    make_pass *pass = context;
     wc_candidates *c = pass->cand;
-    wc_list_maker *m = &c->makers[team->thread];
-    int64_t begin, end;
-    wc_team_slice(team, pass->count, team->threads > 1, &begin, &end);
+    /* a copy of its own: the makers lie side by side, and a thread writing
+     * to its maker at every list takes the other's cache line from it. (On
+     * the 10,201-particle drape, making lists on 2 threads took 1.25 times
+     * less time than on 1 with equal slices and the makers written in
+     * place, 1.7 times less with the claims and the copies.) */
+    wc_list_maker own = c->makers[team->thread], *m = &own;
     m->used = 0;
-    for (int64_t j = begin; j < end && !m->failed; ++j) {
-        wc_list_job *job = &c->jobs[pass->first + j];
-        job->maker = team->thread;
-        int ok = job->kind == LIST_PARTICLE ? particle_pairs(c, m, pass->col, job)
-                 : job->kind == LIST_TRIANGLE ? triangle_pairs(c, m, pass->el, pass->col, job)
-                                              : edge_pairs(c, m, pass->el, pass->col, job);
-        m->failed = !ok;
+    while (!m->failed) {
+        int32_t begin;
+#pragma omp atomic capture
+        {
+            begin = pass->next;
+            pass->next += LISTS_CLAIM;
+        }
+        if (begin >= pass->count) break;
+        int32_t end = pass->count - begin < LISTS_CLAIM ? pass->count : begin + LISTS_CLAIM;
+        for (int32_t j = begin; j < end && !m->failed; ++j) {
+            wc_list_job *job = &c->jobs[pass->first + j];
+            job->maker = team->thread;
+            int ok = job->kind == LIST_PARTICLE ? particle_pairs(c, m, pass->col, job)
+                     : job->kind == LIST_TRIANGLE ? triangle_pairs(c, m, pass->el, pass->col, job)
+                                                  : edge_pairs(c, m, pass->el, pass->col, job);
+            m->failed = !ok;
+        }
     }
+    c->makers[team->thread] = own;
 }
 
 /* Owner job->owner's list from its pairs: the snapshot is its particles'
@@ -547,7 +571,7 @@ static int make_lists(wc_candidates *c, const wc_cloth_elements *el, const wc_co
 {
     int team = count >= LISTS_PARALLEL_MIN ? threads : 1;
     for (int32_t first = 0; first < count; first += LISTS_BATCH) {
-        make_pass pass = {c, el, col, first, count - first < LISTS_BATCH ? count - first : LISTS_BATCH};
+        make_pass pass = {c, el, col, first, count - first < LISTS_BATCH ? count - first : LISTS_BATCH, 0};
         /* every maker, not only those the runtime gives the team */
         for (int32_t t = 0; t < c->maker_count; ++t) c->makers[t].failed = 0;
         wci_parallel_team(team, make_body, &pass);
