@@ -323,6 +323,41 @@ static void note_rebase(wc_collider_contacts *s, int32_t i)
     s->rebase_list[s->rebase_count++] = i;
 }
 
+/* Which particles to rebase against a collider, looked at on every thread:
+ * with `only_shifted` those the particle pass moved (s->shifted) whose
+ * motion has left their cover, else those due a rebase ahead of the step
+ * (wc_candidates_rebase_due). Flags them in s->rebase_flag. */
+typedef struct rebase_scan {
+    wc_collider_contacts *s;
+    const wc_candidates *cand;
+    const wc_particle_arrays *p;
+    int only_shifted;
+} rebase_scan;
+
+static int rebase_scan_range(void *context, int64_t begin, int64_t end)
+{
+    const rebase_scan *scan = context;
+    wc_collider_contacts *s = scan->s;
+    for (int64_t i = begin; i < end; ++i) {
+        if (scan->only_shifted && !s->shifted[i]) continue;
+        double d = wci_candidates_displacement(scan->cand, scan->p, (int32_t)i);
+        s->rebase_flag[i] = scan->only_shifted ? !wc_candidates_covers(scan->cand, (int32_t)i, d)
+                                               : wc_candidates_rebase_due(scan->cand, (int32_t)i, d);
+    }
+    return 0;
+}
+
+/* Notes, in ascending order, the particles that rebase_scan_range flags
+ * (no particle is noted when it runs). */
+static void note_scanned(wc_collider_contacts *s, const wc_candidates *cand,
+                         const wc_particle_arrays *p, int32_t n, int only_shifted, int threads)
+{
+    rebase_scan scan = {s, cand, p, only_shifted};
+    wci_parallel_for(n, wc_threads_for(n, threads), rebase_scan_range, &scan);
+    for (int32_t i = 0; i < n; ++i)
+        if (s->rebase_flag[i]) s->rebase_list[s->rebase_count++] = i;
+}
+
 /* Rebases the noted particles against collider k and clears the notes. */
 static wc_status flush_rebase(wc_collider_contacts *s, const wc_collider *col, int32_t k,
                               const wc_particle_arrays *p, int32_t steps_left, int threads)
@@ -358,9 +393,7 @@ static wc_status refresh_candidates(wc_collider_contacts *s, const wc_cloth *c,
             wci_candidates_local_motion(cand, &s->el, col, threads);
         }
         if (!col->moving && wci_support_prepare(&s->support[k], col, r)) return WC_ERROR_OUT_OF_MEMORY;
-        for (int32_t i = 0; i < c->particle_count; ++i)
-            if (wc_candidates_rebase_due(cand, i, wci_candidates_displacement(cand, p, i)))
-                note_rebase(s, i);
+        note_scanned(s, cand, p, c->particle_count, 0, threads);
         if (flush_rebase(s, col, k, p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
     }
     return WC_OK;
@@ -1071,10 +1104,7 @@ static wc_status pass_rounds(wc_collider_contacts *s, wc_cloth *c, const wc_part
          * the feature pass and the next step */
         for (int32_t k = 0; k < count; ++k) {
             if (!colliders[k]->is_mesh) continue;
-            for (int32_t i = 0; i < c->particle_count; ++i)
-                if (s->shifted[i] &&
-                    !wc_candidates_covers(&s->cand[k], i, wci_candidates_displacement(&s->cand[k], p, i)))
-                    note_rebase(s, i);
+            note_scanned(s, &s->cand[k], p, c->particle_count, 1, threads);
             if (flush_rebase(s, colliders[k], k, p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
         }
         int moved = feature_pass(s, c, p, colliders, count, all && round == 0, steps_left, failsafe);
@@ -1134,13 +1164,27 @@ static void measure_wanted(wc_collider_contacts *s, const wc_cloth *c, wc_collid
     }
 }
 
+/* What track_range reads. */
+typedef struct track_pass {
+    wc_collider_contacts *s;
+    const wc_particle_arrays *p;
+} track_pass;
+
+static int track_range(void *context, int64_t begin, int64_t end)
+{
+    const track_pass *pass = context;
+    for (int64_t i = begin; i < end; ++i) track(pass->s, pass->p, (int32_t)i);
+    return 0;
+}
+
 /* The stage over every particle: their motions noted, the lists made or
  * brought up to date, the passes. */
 static wc_status whole_stage(wc_collider_contacts *s, wc_cloth *c, const wc_particle_arrays *p,
                              wc_collider *const *colliders, int32_t count, int32_t steps_left,
                              int threads, wc_step_stats *stats)
 {
-    for (int32_t i = 0; i < c->particle_count; ++i) track(s, p, i);
+    track_pass tracking = {s, p};
+    wci_parallel_for(c->particle_count, wc_threads_for(c->particle_count, threads), track_range, &tracking);
     memset(s->changed, 0, (size_t)c->particle_count);
     if (refresh_candidates(s, c, colliders, count, p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
     measure_wanted(s, c, colliders, count);

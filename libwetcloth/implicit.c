@@ -530,6 +530,7 @@ static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t en
     wc_implicit_state *s = pass->state;
     double h = pass->h, drag = c->material.air_drag, h2 = h * h;
     const int32_t *soft = c->pins.soft_count ? c->soft_pin_slot : NULL;
+    int bad = 0;
     for (int64_t i = begin; i < end; ++i) {
         double *b = s->rhs + 3 * (size_t)i, *pre = s->precond + 6 * (size_t)i;
         if (c->pin_slot[i] >= 0) {
@@ -564,9 +565,10 @@ static int rhs_and_preconditioner_range(void *context, int64_t begin, int64_t en
             }
         }
         b[0] = bx, b[1] = by, b[2] = bz;
+        bad = bad || !(isfinite(bx) && isfinite(by) && isfinite(bz));
         wci_sym3_inverse(diag, pre);
     }
-    return 0;
+    return bad;
 }
 
 /* The loops of one CG iteration run over fixed blocks of BLOCK particles,
@@ -979,19 +981,22 @@ static int positions_range(void *context, int64_t begin, int64_t end)
     wc_cloth *c = pass->cloth;
     const wc_implicit_state *s = pass->state;
     double dt = pass->dt, share = pass->share;
+    int bad = 0;
     for (int64_t i = begin; i < end; ++i) {
         if (c->pin_slot[i] >= 0) {
             double p[3];
             wci_pinned_position(c, c->pin_slot[i], pass->pin_fraction, p);
             c->nx[i] = p[0], c->ny[i] = p[1], c->nz[i] = p[2];
+            bad = bad || !(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]));
             continue;
         }
         const double *v = s->v0 + 3 * (size_t)i, *y = s->y + 3 * (size_t)i;
         c->nx[i] = c->x[i] + dt * (v[0] + share * y[0]);
         c->ny[i] = c->y[i] + dt * (v[1] + share * y[1]);
         c->nz[i] = c->z[i] + dt * (v[2] + share * y[2]);
+        bad = bad || !(isfinite(c->nx[i]) && isfinite(c->ny[i]) && isfinite(c->nz[i]));
     }
-    return 0;
+    return bad;
 }
 
 int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, double tolerance,
@@ -1019,9 +1024,12 @@ int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doub
     pass.share = (dt + h_prev) / (2.0 * dt);
     wci_parallel_for(n, particle_threads, start_velocities_range, &pass);
     active_links(&pass, threads);
-    wci_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass);
-    int32_t bad = first_non_finite_rhs(s);
-    if (bad >= 0) return bad;
+    /* the first particle with a non-finite right-hand side looked for only
+     * when the loop found one */
+    if (wci_parallel_for(n, particle_threads, rhs_and_preconditioner_range, &pass)) {
+        int32_t bad = first_non_finite_rhs(s);
+        if (bad >= 0) return bad;
+    }
     if (s->multigrid)
         wci_multigrid_update(s->multigrid, s->mass_diag, s->active_block, s->active_slot,
                              c->pins.count > c->pins.soft_count ? c->pin_slot : NULL, threads);
@@ -1029,6 +1037,6 @@ int32_t wci_integrate_implicit(wc_cloth *c, double dt, double pin_fraction, doub
         translation_matrix(c, s);
     solve(&pass, tolerance * dt, threads);
     positions_pass positions = {c, s, dt, pin_fraction, pass.share};
-    wci_parallel_for(n, particle_threads, positions_range, &positions);
+    if (!wci_parallel_for(n, particle_threads, positions_range, &positions)) return -1;
     return wci_first_non_finite_xyz(c->nx, c->ny, c->nz, n);
 }

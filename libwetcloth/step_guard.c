@@ -106,16 +106,40 @@ static double squared_length(const double *x, const double *y, const double *z, 
     return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
 }
 
-int32_t wci_step_tears(const wc_cloth *c, double ratio, double growth)
+/* What wci_step_tears reads. */
+typedef struct tear_pass {
+    const wc_cloth *cloth;
+    double ratio, growth;
+} tear_pass;
+
+/* The first link of [begin, end) that tears, or -1. */
+static int32_t first_tear(const tear_pass *pass, int64_t begin, int64_t end)
 {
+    const wc_cloth *c = pass->cloth;
     const wc_link_set *s = &c->topology.stretch;
-    for (int32_t e = 0; e < s->count; ++e) {
-        double limit = ratio * s->rest[e];
+    for (int64_t e = begin; e < end; ++e) {
+        double limit = pass->ratio * s->rest[e];
         double end2 = squared_length(c->nx, c->ny, c->nz, s->a[e], s->b[e]);
         /* the root only for the rare link past the ratio */
         if (!(end2 > limit * limit)) continue;
         double start = sqrt(squared_length(c->x, c->y, c->z, s->a[e], s->b[e]));
-        if (sqrt(end2) - start > growth * s->rest[e]) return e;
+        if (sqrt(end2) - start > pass->growth * s->rest[e]) return (int32_t)e;
     }
     return -1;
+}
+
+static int tear_range(void *context, int64_t begin, int64_t end)
+{
+    return first_tear(context, begin, end) >= 0;
+}
+
+/* Every link looked at on every thread; the first that tears is looked
+ * for again on one, only when some link does (a step that tears is taken
+ * again as two: rare). */
+int32_t wci_step_tears(const wc_cloth *c, double ratio, double growth, int threads)
+{
+    tear_pass pass = {c, ratio, growth};
+    int64_t n = c->topology.stretch.count;
+    if (!wci_parallel_for(n, wc_threads_for(n, threads), tear_range, &pass)) return -1;
+    return first_tear(&pass, 0, n);
 }

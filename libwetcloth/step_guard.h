@@ -77,7 +77,8 @@ int32_t wci_step_guard_check(const struct wc_cloth *cloth, const wc_step_guard *
 
 /// The first stretch link of the cloth that the step from (x, y, z) to
 /// (nx, ny, nz) stretches past `ratio` times its rest length, by more than
-/// `growth` times it (WC_TEAR_RATIO and WC_TEAR_GROWTH: it tears), or -1.
-int32_t wci_step_tears(const struct wc_cloth *cloth, double ratio, double growth);
+/// `growth` times it (WC_TEAR_RATIO and WC_TEAR_GROWTH: it tears), or -1;
+/// the links looked at on up to `threads` threads.
+int32_t wci_step_tears(const struct wc_cloth *cloth, double ratio, double growth, int threads);
 
 #endif

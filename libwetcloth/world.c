@@ -401,7 +401,7 @@ static int step_tears(const wc_world *w, const step_context *ctx)
 {
     if (!ctx->colliding) return 0;
     for (int32_t c = 0; c < w->cloth_count; ++c)
-        if (wci_step_tears(w->cloths[c], w->tear_ratio, w->tear_growth) >= 0) return 1;
+        if (wci_step_tears(w->cloths[c], w->tear_ratio, w->tear_growth, ctx->threads) >= 0) return 1;
     return 0;
 }
 

@@ -206,7 +206,7 @@ static int32_t tears_at(wc_world *w, double from, double to)
         memcpy(end[k], pos[k], (size_t)c->particle_count * sizeof(double));
         end[k][b] = pos[k][a] + d[k] / len * to * l->rest[0];
     }
-    int32_t e = wci_step_tears(c, WC_TEAR_RATIO, WC_TEAR_GROWTH);
+    int32_t e = wci_step_tears(c, WC_TEAR_RATIO, WC_TEAR_GROWTH, 2);
     for (int k = 0; k < 3; ++k) memcpy(pos[k], keep[k], (size_t)c->particle_count * sizeof(double));
     return e;
 }
