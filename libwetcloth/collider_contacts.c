@@ -101,13 +101,19 @@ struct wc_collider_contacts {
 /* Motion                                                                   */
 /* ------------------------------------------------------------------------ */
 
+/* How far particle i moves over the step, m. */
+static double step_motion(const wc_particle_arrays *p, int32_t i)
+{
+    double u[3] = {p->nx[i] - p->x[i], p->ny[i] - p->y[i], p->nz[i] - p->z[i]};
+    return sqrt(dot3(u, u));
+}
+
 /* Particle i's end of step has moved: its motion over the step noted, and
  * the change for wci_collider_contacts_recheck. Touches only particle i's
  * entries (safe in the parallel particle pass). */
 static void track(wc_collider_contacts *s, const wc_particle_arrays *p, int32_t i)
 {
-    double u[3] = {p->nx[i] - p->x[i], p->ny[i] - p->y[i], p->nz[i] - p->z[i]};
-    s->motion[i] = sqrt(dot3(u, u));
+    s->motion[i] = step_motion(p, i);
     s->changed[i] = 1;
 }
 
@@ -1164,16 +1170,18 @@ static void measure_wanted(wc_collider_contacts *s, const wc_cloth *c, wc_collid
     }
 }
 
-/* What track_range reads. */
-typedef struct track_pass {
+/* What motions_range reads. */
+typedef struct motions_pass {
     wc_collider_contacts *s;
     const wc_particle_arrays *p;
-} track_pass;
+} motions_pass;
 
-static int track_range(void *context, int64_t begin, int64_t end)
+/* Every particle's motion over the step, at the stage's start: no change
+ * is noted (whole_stage clears the notes; every particle is looked at). */
+static int motions_range(void *context, int64_t begin, int64_t end)
 {
-    const track_pass *pass = context;
-    for (int64_t i = begin; i < end; ++i) track(pass->s, pass->p, (int32_t)i);
+    const motions_pass *pass = context;
+    for (int64_t i = begin; i < end; ++i) pass->s->motion[i] = step_motion(pass->p, (int32_t)i);
     return 0;
 }
 
@@ -1183,8 +1191,9 @@ static wc_status whole_stage(wc_collider_contacts *s, wc_cloth *c, const wc_part
                              wc_collider *const *colliders, int32_t count, int32_t steps_left,
                              int threads, wc_step_stats *stats)
 {
-    track_pass tracking = {s, p};
-    wci_parallel_for(c->particle_count, wc_threads_for(c->particle_count, threads), track_range, &tracking);
+    motions_pass motions = {s, p};
+    wci_parallel_for(c->particle_count, wc_threads_for(c->particle_count, threads), motions_range,
+                     &motions);
     memset(s->changed, 0, (size_t)c->particle_count);
     if (refresh_candidates(s, c, colliders, count, p, steps_left, threads)) return WC_ERROR_OUT_OF_MEMORY;
     measure_wanted(s, c, colliders, count);
